@@ -1,0 +1,76 @@
+"""Error metrics of shared/design/EVALUATION.md. Images are float arrays (H, W, 3), linear RGB.
+
+- relMSE: mean over pixels and RGB channels of (I - R)^2 / (R^2 + 0.01)
+- RMSE: sqrt(mean((I - R)^2))
+- mean absolute relative error: mean(|I - R| / (|R| + 0.01))
+"""
+from __future__ import annotations
+
+import numpy as np
+
+EPS = 0.01
+
+
+def _pair(img, ref):
+    a = np.asarray(img, dtype=np.float64)
+    r = np.asarray(ref, dtype=np.float64)
+    if a.shape != r.shape:
+        raise ValueError(f"image shape {a.shape} != reference shape {r.shape}")
+    return a, r
+
+
+def relmse_map(img, ref, eps: float = EPS) -> np.ndarray:
+    """Per-pixel relMSE averaged over channels, shape (H, W)."""
+    a, r = _pair(img, ref)
+    m = (a - r) ** 2 / (r * r + eps)
+    return m.mean(axis=-1) if m.ndim == 3 else m
+
+
+def relmse(img, ref, eps: float = EPS) -> float:
+    a, r = _pair(img, ref)
+    return float(np.mean((a - r) ** 2 / (r * r + eps)))
+
+
+def rmse(img, ref) -> float:
+    a, r = _pair(img, ref)
+    return float(np.sqrt(np.mean((a - r) ** 2)))
+
+
+def mean_abs_rel_error(img, ref, eps: float = EPS) -> float:
+    a, r = _pair(img, ref)
+    return float(np.mean(np.abs(a - r) / (np.abs(r) + eps)))
+
+
+def image_mean(img) -> float:
+    """Mean over pixels and channels."""
+    return float(np.mean(np.asarray(img, dtype=np.float64)))
+
+
+def mean_stderr(img, ref, block: int = 8) -> float:
+    """Standard error of image_mean(img) as an estimate of image_mean(ref), from the noise in img - ref.
+
+    The difference image is averaged over block x block tiles (the reconstruction filter correlates
+    neighbouring pixels, tiles make the tile means nearly independent); the standard error is
+    std(tile means) / sqrt(number of tiles). It includes the reference's own noise, which is small
+    when the reference has many more samples.
+    """
+    a, r = _pair(img, ref)
+    d = (a - r).mean(axis=-1) if a.ndim == 3 else a - r
+    h, w = d.shape
+    hb, wb = h // block, w // block
+    if hb * wb < 2:
+        return float(np.std(d) / np.sqrt(d.size))
+    tiles = d[: hb * block, : wb * block].reshape(hb, block, wb, block).mean(axis=(1, 3))
+    return float(np.std(tiles, ddof=1) / np.sqrt(tiles.size))
+
+
+def all_metrics(img, ref) -> dict:
+    return {
+        "relmse": relmse(img, ref),
+        "rmse": rmse(img, ref),
+        "mean_abs_rel_error": mean_abs_rel_error(img, ref),
+        "mean": image_mean(img),
+        "ref_mean": image_mean(ref),
+        "mean_ratio": image_mean(img) / image_mean(ref) if image_mean(ref) != 0 else float("nan"),
+        "mean_stderr": mean_stderr(img, ref),
+    }

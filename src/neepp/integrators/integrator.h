@@ -1,0 +1,34 @@
+// The integrator interface: estimates the radiance arriving along a camera ray. The render loop owns
+// threads, passes and time; integrators own the light transport and may keep state between passes
+// (NEE++ publishes its visibility map there).
+#pragma once
+#include <memory>
+#include <string>
+#include <nlohmann/json.hpp>
+#include "neepp/integrators/options.h"
+#include "neepp/render/stats.h"
+#include "neepp/scene/interaction.h"
+
+namespace neepp {
+
+class Scene;
+class Sampler;
+
+class Integrator {
+public:
+    virtual ~Integrator() = default;
+    // Called once before rendering starts (build tables, seed maps).
+    virtual void prepare(const Scene &scene) {}
+    virtual Color Li(const Scene &scene, const Ray &ray, Sampler &sampler, RenderCounters &counters) const = 0;
+    // Called between passes, single-threaded, after all samples of the pass are in.
+    virtual void end_pass(const Scene &scene, int pass_index) {}
+    // Name and effective options, for the statistics file.
+    virtual nlohmann::json describe() const = 0;
+    // Extra statistics of this integrator (map size, rays skipped...), merged into the stats file.
+    virtual nlohmann::json statistics() const { return nlohmann::json::object(); }
+};
+
+// Creates an integrator by name ("path") from its options; throws on unknown names or unused options.
+std::unique_ptr<Integrator> make_integrator(const std::string &name, const Options &options);
+
+}  // namespace neepp

@@ -1,0 +1,118 @@
+#include "neepp/integrators/path.h"
+
+#include "neepp/materials/bsdf.h"
+#include "neepp/math/warp.h"
+#include "neepp/sampling/sampler.h"
+#include "neepp/scene/scene.h"
+
+namespace neepp {
+
+PathIntegrator::PathIntegrator(PathOptions options, std::unique_ptr<ShadowRayTester> shadow)
+    : options_(std::move(options)), shadow_(std::move(shadow)) {}
+
+void PathIntegrator::prepare(const Scene &scene) {
+    light_sampler_ = make_light_sampler(options_.light_sampler, scene.light_pointers());
+}
+
+nlohmann::json PathIntegrator::describe() const {
+    return {{"name", "path"},
+            {"max_depth", options_.max_depth},
+            {"rr_depth", options_.rr_depth},
+            {"hide_emitters", options_.hide_emitters},
+            {"nee", options_.nee},
+            {"light_sampler", options_.light_sampler},
+            {"shadow_rays", shadow_->policy()}};
+}
+
+float PathIntegrator::emission_weight(const Light &light, const LightSampleContext &prev, const DirectionSample &ds,
+                                      float prev_pdf) const {
+    if (!options_.nee) return 1.f;
+    float light_pdf = light_sampler_->pmf(prev, light) * light.pdf_direction(prev.p, ds);
+    return mis_power(prev_pdf, light_pdf);
+}
+
+Color PathIntegrator::sample_direct(const Scene &scene, const SurfaceInteraction &si, const BSDF &bsdf,
+                                    Sampler &sampler, RenderCounters &counters) const {
+    LightSampleContext ctx{si.p, si.n};
+    SampledLight sl = light_sampler_->sample(ctx, sampler.next_1d());
+    Vec2 u = sampler.next_2d();
+    if (!sl.light || sl.pmf <= 0) return Color(0.f);
+    Color Le;
+    DirectionSample ds = sl.light->sample_direction(si.p, u, Le);
+    if (!(ds.pdf > 0) || is_black(Le)) return Color(0.f);
+    Vec3 wo = si.to_local(ds.d);
+    BSDFContext bctx;
+    Color f = bsdf.eval(bctx, si, si.wi, wo);
+    if (is_black(f)) return Color(0.f);
+    float light_pdf = ds.pdf * sl.pmf;
+    float w = ds.delta ? 1.f : mis_power(light_pdf, bsdf.pdf(bctx, si, si.wi, wo));
+    ShadowQuery q;
+    q.ray = ds.dist >= kInfinity ? si.spawn_ray(ds.d) : si.spawn_ray_to(ds.p);
+    q.from = si.p;
+    q.to = ds.p;
+    q.unoccluded = f * Le * (w / light_pdf);
+    return q.unoccluded * shadow_->visibility(scene, q, sampler, counters);
+}
+
+Color PathIntegrator::Li(const Scene &scene, const Ray &primary, Sampler &sampler, RenderCounters &counters) const {
+    Color L(0.f), beta(1.f);
+    float eta = 1.f;
+    Ray ray = primary;
+    LightSampleContext prev;       // the previous scattering vertex, for MIS on emitters hit
+    float prev_bsdf_pdf = 1.f;
+    bool prev_delta = true;        // the camera counts as a delta vertex: no MIS on directly seen lights
+    const bool count_direct = !options_.hide_emitters;
+
+    for (int depth = 0;; ) {
+        SurfaceInteraction si;
+        ++counters.rays;
+        bool hit = scene.intersect(ray, si);
+        bool show_emission = depth > 0 || count_direct;
+
+        if (!hit) {
+            if (show_emission)
+                for (const Light *env : scene.infinite_lights()) {
+                    Color Le = env->eval_environment(ray.d);
+                    if (is_black(Le)) continue;
+                    float w = prev_delta ? 1.f : emission_weight(*env, prev, direction_sample_from_miss(ray.d), prev_bsdf_pdf);
+                    L += beta * Le * w;
+                }
+            break;
+        }
+        if (const Light *area = si.shape->area_light; area && show_emission) {
+            Color Le = area->eval_surface(si, -ray.d);
+            if (!is_black(Le)) {
+                float w = prev_delta ? 1.f : emission_weight(*area, prev, direction_sample_from_hit(prev.p, si), prev_bsdf_pdf);
+                L += beta * Le * w;
+            }
+        }
+        if (options_.max_depth >= 0 && depth + 1 >= options_.max_depth) break;
+
+        const BSDF &bsdf = *si.shape->bsdf;
+        if (options_.nee && bsdf.has_flag(BSDFSmooth))
+            L += beta * sample_direct(scene, si, bsdf, sampler, counters);
+
+        float u1 = sampler.next_1d();
+        Vec2 u2 = sampler.next_2d();
+        BSDFSample bs = bsdf.sample(BSDFContext{}, si, si.wi, u1, u2);
+        if (!bs.valid()) break;
+        beta *= bs.weight;
+        eta *= bs.eta;
+        prev = LightSampleContext{si.p, si.n};
+        prev_bsdf_pdf = bs.pdf;
+        prev_delta = (bs.sampled_flags & BSDFDelta) != 0;
+        ray = si.spawn_ray(si.to_world(bs.wo));
+        ++depth;
+
+        // Russian roulette on the throughput (times eta^2 so refraction does not trigger it), Mitsuba's rule.
+        if (depth >= options_.rr_depth) {
+            float q = std::min(max_component(beta) * eta * eta, 0.95f);
+            if (!(sampler.next_1d() < q)) break;
+            beta /= q;
+        }
+        if (max_component(beta) <= 0) break;
+    }
+    return L;
+}
+
+}  // namespace neepp

@@ -1,0 +1,42 @@
+// Unidirectional path tracing with Mitsuba 3's `path` semantics: next event estimation combined with BSDF
+// sampling by the power heuristic, Russian roulette from rr_depth, max_depth counting path vertices
+// (1 = emitters seen directly, 2 = direct lighting, -1 = unbounded). With nee=false it is the paper's
+// "Path" baseline (BSDF sampling only, lights found by chance).
+#pragma once
+#include <memory>
+#include "neepp/integrators/integrator.h"
+#include "neepp/lights/light_sampler.h"
+#include "neepp/visibility/shadow_ray_tester.h"
+
+namespace neepp {
+
+struct PathOptions {
+    int max_depth = -1;
+    int rr_depth = 5;
+    bool hide_emitters = false;
+    bool nee = true;
+    std::string light_sampler = "power";
+};
+
+class PathIntegrator final : public Integrator {
+public:
+    explicit PathIntegrator(PathOptions options, std::unique_ptr<ShadowRayTester> shadow);
+    void prepare(const Scene &scene) override;
+    Color Li(const Scene &scene, const Ray &ray, Sampler &sampler, RenderCounters &counters) const override;
+    nlohmann::json describe() const override;
+    const PathOptions &options() const { return options_; }
+
+private:
+    // Radiance from light sources by light sampling at si, MIS-weighted against BSDF sampling.
+    Color sample_direct(const Scene &scene, const SurfaceInteraction &si, const class BSDF &bsdf, Sampler &sampler,
+                        RenderCounters &counters) const;
+    // MIS weight for emission found by a BSDF-sampled ray leaving prev (pdf prev_pdf) toward light.
+    float emission_weight(const Light &light, const LightSampleContext &prev, const DirectionSample &ds,
+                          float prev_pdf) const;
+
+    PathOptions options_;
+    std::unique_ptr<ShadowRayTester> shadow_;
+    std::unique_ptr<LightSampler> light_sampler_;
+};
+
+}  // namespace neepp

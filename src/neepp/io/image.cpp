@@ -1,0 +1,243 @@
+#include "neepp/io/image.h"
+
+#include <IexBaseExc.h>
+#include <ImfChannelList.h>
+#include <ImfFrameBuffer.h>
+#include <ImfHeader.h>
+#include <ImfInputFile.h>
+#include <ImfOutputFile.h>
+#include <fmt/format.h>
+#include <stb/stb_image.h>
+#include <stb/stb_image_write.h>
+#ifdef NEEPP_HAVE_LIBJPEG
+#include <csetjmp>
+#include <jpeglib.h>
+#endif
+
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <memory>
+#include <stdexcept>
+
+namespace neepp {
+
+namespace {
+
+[[noreturn]] void fail(const std::string &path, const std::string &what) {
+    throw std::runtime_error(fmt::format("image '{}': {}", path, what));
+}
+
+// EXR channel names per channel count, alpha last (Image's layout).
+std::vector<std::string> channel_names(int channels) {
+    switch (channels) {
+        case 1: return {"Y"};
+        case 2: return {"Y", "A"};
+        case 3: return {"R", "G", "B"};
+        case 4: return {"R", "G", "B", "A"};
+        default: return {};
+    }
+}
+
+enum class FileKind { Exr, Jpeg, Other };
+
+FileKind sniff(const std::string &path) {
+    std::unique_ptr<FILE, int (*)(FILE *)> f(std::fopen(path.c_str(), "rb"), &std::fclose);
+    if (!f) fail(path, "cannot open file");
+    unsigned char magic[4] = {};
+    size_t n = std::fread(magic, 1, 4, f.get());
+    static const unsigned char kExrMagic[4] = {0x76, 0x2f, 0x31, 0x01};
+    if (n == 4 && std::memcmp(magic, kExrMagic, 4) == 0) return FileKind::Exr;
+    if (n >= 2 && magic[0] == 0xff && magic[1] == 0xd8) return FileKind::Jpeg;
+    return FileKind::Other;
+}
+
+#ifdef NEEPP_HAVE_LIBJPEG
+// Mitsuba decodes JPEG with libjpeg(-turbo) at its default settings (islow IDCT, fancy upsampling);
+// stb_image's decoder differs from it by up to 3/255 on a few percent of the values, so when the build
+// links libjpeg we decode with it to get Mitsuba's texels exactly.
+struct JpegError {
+    jpeg_error_mgr mgr;
+    std::jmp_buf jump;
+    char message[JMSG_LENGTH_MAX] = {};
+};
+
+Image read_jpeg(const std::string &path) {
+    std::unique_ptr<FILE, int (*)(FILE *)> f(std::fopen(path.c_str(), "rb"), &std::fclose);
+    if (!f) fail(path, "cannot open file");
+    jpeg_decompress_struct cinfo;
+    JpegError err;
+    cinfo.err = jpeg_std_error(&err.mgr);
+    err.mgr.error_exit = [](j_common_ptr c) {
+        auto *e = reinterpret_cast<JpegError *>(c->err);
+        e->mgr.format_message(c, e->message);
+        std::longjmp(e->jump, 1);
+    };
+    Image img;
+    if (setjmp(err.jump)) {  // libjpeg reports errors by longjmp to here
+        jpeg_destroy_decompress(&cinfo);
+        fail(path, std::string("corrupt JPEG file: ") + err.message);
+    }
+    jpeg_create_decompress(&cinfo);
+    jpeg_stdio_src(&cinfo, f.get());
+    jpeg_read_header(&cinfo, TRUE);
+    jpeg_start_decompress(&cinfo);
+    const int w = int(cinfo.output_width), h = int(cinfo.output_height), n = cinfo.output_components;
+    if (n != 1 && n != 3) {
+        jpeg_destroy_decompress(&cinfo);
+        fail(path, "unsupported JPEG color layout (only gray and RGB)");
+    }
+    img = Image(w, h, n);
+    img.srgb_encoded = true;
+    // The scanline buffer comes from libjpeg's pool: a longjmp must not skip a C++ destructor.
+    JSAMPARRAY row = (*cinfo.mem->alloc_sarray)(reinterpret_cast<j_common_ptr>(&cinfo), JPOOL_IMAGE,
+                                                JDIMENSION(w * n), 1);
+    while (cinfo.output_scanline < cinfo.output_height) {
+        float *dst = &img.data[size_t(cinfo.output_scanline) * w * n];
+        jpeg_read_scanlines(&cinfo, row, 1);
+        for (int i = 0; i < w * n; ++i) dst[i] = float(row[0][i]) * (1.f / 255.f);
+    }
+    jpeg_finish_decompress(&cinfo);
+    jpeg_destroy_decompress(&cinfo);
+    return img;
+}
+#endif
+
+// Which of the file's channels become the image's: RGB(A) if present, else Y(A), else a lone channel.
+std::vector<std::string> pick_exr_channels(const Imf::ChannelList &list, const std::string &path) {
+    auto has = [&](const char *name) { return list.findChannel(name) != nullptr; };
+    std::vector<std::string> names;
+    if (has("R") && has("G") && has("B"))
+        names = {"R", "G", "B"};
+    else if (has("Y"))
+        names = {"Y"};
+    else {
+        std::string all;
+        int count = 0;
+        for (auto it = list.begin(); it != list.end(); ++it, ++count) all += std::string(" ") + it.name();
+        if (count != 1) fail(path, "unsupported OpenEXR channel layout:" + all);
+        return {list.begin().name()};
+    }
+    if (has("A")) names.push_back("A");
+    return names;
+}
+
+Image read_exr(const std::string &path) {
+    try {
+        Imf::InputFile file(path.c_str());
+        const Imath::Box2i dw = file.header().dataWindow();
+        std::vector<std::string> names = pick_exr_channels(file.header().channels(), path);
+        Image img(dw.max.x - dw.min.x + 1, dw.max.y - dw.min.y + 1, int(names.size()));
+        const size_t xstride = sizeof(float) * img.channels, ystride = xstride * img.width;
+        Imf::FrameBuffer fb;
+        // OpenEXR converts half (or uint) channels to the FLOAT slices on read.
+        for (size_t c = 0; c < names.size(); ++c)
+            fb.insert(names[c], Imf::Slice::Make(Imf::FLOAT, img.data.data() + c, dw, xstride, ystride));
+        file.setFrameBuffer(fb);
+        file.readPixels(dw.min.y, dw.max.y);
+        return img;
+    } catch (const Iex::BaseExc &e) {  // OpenEXR's own errors; ours already name the path
+        fail(path, fmt::format("cannot read OpenEXR file: {}", e.what()));
+    }
+}
+
+template <typename T>
+Image image_from_stb(T *pixels, int w, int h, int n, float scale, bool srgb) {
+    Image img(w, h, n);
+    for (size_t i = 0; i < img.data.size(); ++i) img.data[i] = float(pixels[i]) * scale;
+    img.srgb_encoded = srgb;
+    stbi_image_free(pixels);
+    return img;
+}
+
+// stbi_loadf is avoided for integer files: it applies a gamma-2.2 curve instead of keeping the codes.
+Image read_stb(const std::string &path) {
+    const char *p = path.c_str();
+    int w = 0, h = 0, n = 0;
+    if (stbi_is_hdr(p)) {
+        if (float *px = stbi_loadf(p, &w, &h, &n, 0)) return image_from_stb(px, w, h, n, 1.f, false);
+    } else if (stbi_is_16_bit(p)) {
+        if (stbi_us *px = stbi_load_16(p, &w, &h, &n, 0))
+            return image_from_stb(px, w, h, n, 1.f / 65535.f, true);
+    } else if (stbi_uc *px = stbi_load(p, &w, &h, &n, 0)) {
+        // Multiplying by the reciprocal (not dividing) reproduces Dr.Jit's 8-bit texel decode bit for bit.
+        return image_from_stb(px, w, h, n, 1.f / 255.f, true);
+    }
+    const char *why = stbi_failure_reason();
+    fail(path, fmt::format("unsupported or corrupt image file ({})", why ? why : "unknown error"));
+}
+
+void check_writable(const std::string &path, const Image &img) {
+    if (img.width <= 0 || img.height <= 0 || img.channels < 1 || img.channels > 4 ||
+        img.data.size() != size_t(img.width) * img.height * img.channels)
+        fail(path, fmt::format("cannot write an invalid image ({}x{}, {} channels, {} values)", img.width,
+                               img.height, img.channels, img.data.size()));
+}
+
+}  // namespace
+
+Image read_image(const std::string &path) {
+    std::error_code ec;
+    if (!std::filesystem::is_regular_file(path, ec)) fail(path, "no such file");
+    switch (sniff(path)) {
+        case FileKind::Exr: return read_exr(path);
+#ifdef NEEPP_HAVE_LIBJPEG
+        case FileKind::Jpeg: return read_jpeg(path);
+#endif
+        default: return read_stb(path);
+    }
+}
+
+void write_exr(const std::string &path, const Image &img, bool half) {
+    check_writable(path, img);
+    const std::vector<std::string> names = channel_names(img.channels);
+    const Imf::PixelType type = half ? Imf::HALF : Imf::FLOAT;
+    std::vector<Imath::half> halves;
+    if (half) halves.assign(img.data.begin(), img.data.end());
+    const size_t elem = half ? sizeof(Imath::half) : sizeof(float);
+    char *base = half ? reinterpret_cast<char *>(halves.data())
+                      : reinterpret_cast<char *>(const_cast<float *>(img.data.data()));
+    try {
+        Imf::Header header(img.width, img.height);
+        header.compression() = Imf::ZIP_COMPRESSION;
+        Imf::FrameBuffer fb;
+        const size_t xstride = elem * img.channels, ystride = xstride * img.width;
+        for (size_t c = 0; c < names.size(); ++c) {
+            header.channels().insert(names[c], Imf::Channel(type));
+            fb.insert(names[c], Imf::Slice(type, base + c * elem, xstride, ystride));
+        }
+        Imf::OutputFile file(path.c_str(), header);
+        file.setFrameBuffer(fb);
+        file.writePixels(img.height);
+    } catch (const std::exception &e) {
+        fail(path, fmt::format("cannot write OpenEXR file: {}", e.what()));
+    }
+}
+
+void write_png_srgb(const std::string &path, const Image &img, float exposure) {
+    check_writable(path, img);
+    const int color = img.color_channels();
+    std::vector<unsigned char> bytes(img.data.size());
+    for (size_t i = 0; i < img.data.size(); ++i) {
+        const bool alpha = int(i % img.channels) >= color;
+        float v = alpha ? img.data[i] : img.data[i] * exposure;
+        v = std::isnan(v) ? 0.f : std::clamp(v, 0.f, 1.f);
+        if (!alpha) v = linear_to_srgb(v);
+        bytes[i] = (unsigned char)(v * 255.f + 0.5f);
+    }
+    if (!stbi_write_png(path.c_str(), img.width, img.height, img.channels, bytes.data(), img.width * img.channels))
+        fail(path, "cannot write PNG file");
+}
+
+float srgb_to_linear(float v) {
+    const double x = v;
+    return float(x <= 0.04045 ? x / 12.92 : std::pow((x + 0.055) / 1.055, 2.4));
+}
+
+float linear_to_srgb(float v) {
+    const double x = v;
+    return float(x <= 0.0031308 ? x * 12.92 : 1.055 * std::pow(x, 1.0 / 2.4) - 0.055);
+}
+
+}  // namespace neepp

@@ -1,0 +1,74 @@
+// Triangle mesh data as read from a file, before any to_world transform is applied, plus the few
+// helpers the OBJ and PLY readers share.
+#pragma once
+#include <charconv>
+#include <cmath>
+#include <cstdint>
+#include <cstdlib>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <vector>
+#include "neepp/io/scene_error.h"
+#include "neepp/math/vec.h"
+
+namespace neepp {
+
+struct MeshData {
+    std::vector<Vec3> positions;
+    std::vector<Vec3> normals;  // empty when the file has none; else one per position, unit length or zero
+    std::vector<Vec2> uvs;      // empty when the file has none; else one per position
+    std::vector<uint32_t> indices;  // three per triangle, in the file's winding order
+
+    size_t triangle_count() const { return indices.size() / 3; }
+};
+
+namespace mesh_detail {
+
+inline std::string read_file(const std::string &path) {
+    std::ifstream in(path, std::ios::binary);
+    if (!in) throw SceneError(path, "cannot open mesh file");
+    std::ostringstream ss;
+    ss << in.rdbuf();
+    return std::move(ss).str();
+}
+
+// Parses one number at `p` (no leading blanks, '+' allowed) and advances past it. Accepts "nan" and
+// "inf" so that the caller can report them as invalid data instead of as a syntax error.
+inline bool parse_real(const char *&p, const char *end, double &out) {
+    const char *s = p;
+    if (s < end && *s == '+') ++s;
+    auto [q, ec] = std::from_chars(s, end, out);
+    if (ec == std::errc::invalid_argument || q == s) return false;
+    if (ec == std::errc::result_out_of_range) {
+        // from_chars refuses values that over- or underflow; strtod rounds them to inf or 0 as
+        // other readers do, and the finiteness check decides.
+        out = std::strtod(std::string(s, q).c_str(), nullptr);
+    }
+    p = q;
+    return true;
+}
+
+// Checks what both readers must guarantee and normalizes the normals, as Mitsuba does on load.
+inline void finish_mesh(MeshData &m, const std::string &path) {
+    for (size_t k = 0; k < m.positions.size(); ++k)
+        if (!is_finite(m.positions[k]))
+            throw SceneError(path, "vertex " + std::to_string(k) + " has an invalid (NaN or infinite) position");
+    for (size_t k = 0; k < m.normals.size(); ++k) {
+        Vec3 &n = m.normals[k];
+        if (!is_finite(n)) throw SceneError(path, "vertex " + std::to_string(k) + " has an invalid (NaN or infinite) normal");
+        float len = norm(n);
+        // Zero normals are kept: with face_normals=true Mitsuba never reads them, and the factory decides.
+        if (len > 0) n = n / len;
+    }
+    for (size_t k = 0; k < m.uvs.size(); ++k)
+        if (!std::isfinite(m.uvs[k].x) || !std::isfinite(m.uvs[k].y))
+            throw SceneError(path, "vertex " + std::to_string(k) + " has an invalid (NaN or infinite) texture coordinate");
+    for (uint32_t i : m.indices)
+        if (i >= m.positions.size())
+            throw SceneError(path, "face references vertex " + std::to_string(i) + " but there are only " +
+                                       std::to_string(m.positions.size()));
+}
+
+}  // namespace mesh_detail
+}  // namespace neepp

@@ -1,0 +1,625 @@
+// Mitsuba 3 XML reader. The rules follow Mitsuba 3.9's src/core/parser.cpp: attribute checks,
+// $parameter substitution, <default>, transform composition, <ref>/<alias>/<include>.
+#include "neepp/io/xml_tree.h"
+
+#include <algorithm>
+#include <charconv>
+#include <climits>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <initializer_list>
+#include <set>
+#include <sstream>
+#include <string_view>
+#include <pugixml.hpp>
+#include "neepp/math/frame.h"
+
+namespace neepp {
+
+namespace fs = std::filesystem;
+
+const char *kind_name(XmlProperty::Kind kind) {
+    switch (kind) {
+        case XmlProperty::Kind::Integer: return "integer";
+        case XmlProperty::Kind::Float: return "float";
+        case XmlProperty::Kind::Boolean: return "boolean";
+        case XmlProperty::Kind::String: return "string";
+        case XmlProperty::Kind::RGB: return "rgb";
+        case XmlProperty::Kind::Vector: return "vector";
+        case XmlProperty::Kind::Point: return "point";
+        case XmlProperty::Kind::Transform: return "transform";
+    }
+    return "?";
+}
+
+// ---------------------------------------------------------------------------------------------
+// XmlNode accessors
+// ---------------------------------------------------------------------------------------------
+
+namespace {
+
+using Kind = XmlProperty::Kind;
+
+[[noreturn]] void wrong_kind(const XmlNode &node, const std::string &prop, const XmlProperty &p,
+                             const char *expected) {
+    throw SceneError(node.file, p.line, "property \"" + prop + "\" of <" + node.tag + " type=\"" + node.type +
+                                            "\"> is " + kind_name(p.kind) + ", expected " + expected);
+}
+
+float as_float(const XmlNode &n, const std::string &prop, const XmlProperty &p) {
+    if (p.kind == Kind::Float) return float(p.f);
+    if (p.kind == Kind::Integer) return float(p.i);
+    wrong_kind(n, prop, p, "float");
+}
+
+int as_int(const XmlNode &n, const std::string &prop, const XmlProperty &p) {
+    if (p.kind != Kind::Integer) wrong_kind(n, prop, p, "integer");
+    if (p.i < INT_MIN || p.i > INT_MAX)
+        throw SceneError(n.file, p.line, "property \"" + prop + "\": " + std::to_string(p.i) + " is out of range");
+    return int(p.i);
+}
+
+bool as_bool(const XmlNode &n, const std::string &prop, const XmlProperty &p) {
+    if (p.kind != Kind::Boolean) wrong_kind(n, prop, p, "boolean");
+    return p.b;
+}
+
+std::string as_string(const XmlNode &n, const std::string &prop, const XmlProperty &p) {
+    if (p.kind != Kind::String) wrong_kind(n, prop, p, "string");
+    return p.s;
+}
+
+// Mitsuba accepts a plain float wherever a spectrum is expected and treats it as a grey constant.
+Color as_rgb(const XmlNode &n, const std::string &prop, const XmlProperty &p) {
+    if (p.kind == Kind::RGB) return p.v;
+    if (p.kind == Kind::Float) return Color(float(p.f));
+    wrong_kind(n, prop, p, "rgb, spectrum or float");
+}
+
+Vec3 as_vector(const XmlNode &n, const std::string &prop, const XmlProperty &p) {
+    if (p.kind != Kind::Vector && p.kind != Kind::Point) wrong_kind(n, prop, p, "vector or point");
+    return p.v;
+}
+
+}  // namespace
+
+const XmlProperty *XmlNode::find(const std::string &prop, bool required) const {
+    auto it = props.find(prop);
+    if (it == props.end()) {
+        if (required) throw error("missing required property \"" + prop + "\"");
+        return nullptr;
+    }
+    it->second.used = true;
+    return &it->second;
+}
+
+SceneError XmlNode::error(const std::string &problem) const {
+    return SceneError(file, line, "<" + tag + (type.empty() ? "" : " type=\"" + type + "\"") + ">: " + problem);
+}
+
+float XmlNode::get_float(const std::string &prop) const { return as_float(*this, prop, *find(prop, true)); }
+float XmlNode::get_float(const std::string &prop, float def) const {
+    const XmlProperty *p = find(prop, false);
+    return p ? as_float(*this, prop, *p) : def;
+}
+int XmlNode::get_int(const std::string &prop) const { return as_int(*this, prop, *find(prop, true)); }
+int XmlNode::get_int(const std::string &prop, int def) const {
+    const XmlProperty *p = find(prop, false);
+    return p ? as_int(*this, prop, *p) : def;
+}
+bool XmlNode::get_bool(const std::string &prop) const { return as_bool(*this, prop, *find(prop, true)); }
+bool XmlNode::get_bool(const std::string &prop, bool def) const {
+    const XmlProperty *p = find(prop, false);
+    return p ? as_bool(*this, prop, *p) : def;
+}
+std::string XmlNode::get_string(const std::string &prop) const { return as_string(*this, prop, *find(prop, true)); }
+std::string XmlNode::get_string(const std::string &prop, const std::string &def) const {
+    const XmlProperty *p = find(prop, false);
+    return p ? as_string(*this, prop, *p) : def;
+}
+Color XmlNode::get_rgb(const std::string &prop) const { return as_rgb(*this, prop, *find(prop, true)); }
+Color XmlNode::get_rgb(const std::string &prop, const Color &def) const {
+    const XmlProperty *p = find(prop, false);
+    return p ? as_rgb(*this, prop, *p) : def;
+}
+Vec3 XmlNode::get_vector(const std::string &prop) const { return as_vector(*this, prop, *find(prop, true)); }
+Vec3 XmlNode::get_vector(const std::string &prop, const Vec3 &def) const {
+    const XmlProperty *p = find(prop, false);
+    return p ? as_vector(*this, prop, *p) : def;
+}
+Transform XmlNode::get_transform(const std::string &prop, const Transform &def) const {
+    const XmlProperty *p = find(prop, false);
+    if (!p) return def;
+    if (p->kind != Kind::Transform) wrong_kind(*this, prop, *p, "transform");
+    return p->xf;
+}
+
+std::shared_ptr<XmlNode> XmlNode::child(const std::string &child_name) const {
+    for (size_t k = 0; k < children.size(); ++k)
+        if (child_names[k] == child_name) return children[k];
+    return nullptr;
+}
+
+std::vector<std::shared_ptr<XmlNode>> XmlNode::children_with_tag(const std::string &child_tag) const {
+    std::vector<std::shared_ptr<XmlNode>> out;
+    for (const auto &c : children)
+        if (c->tag == child_tag) out.push_back(c);
+    return out;
+}
+
+std::string XmlNode::resolve_path(const std::string &path) const {
+    fs::path p(path);
+    if (p.is_absolute() || base_dir.empty()) return path;
+    return (fs::path(base_dir) / p).lexically_normal().string();
+}
+
+std::vector<std::string> XmlNode::unused_properties() const {
+    std::vector<std::string> out;
+    for (const auto &[key, p] : props)
+        if (!p.used) out.push_back(key);
+    return out;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Parser
+// ---------------------------------------------------------------------------------------------
+
+namespace {
+
+// Mitsuba's tokenizer splits numeric lists at whitespace and commas alike.
+std::vector<std::string_view> tokenize(std::string_view s) {
+    std::vector<std::string_view> out;
+    size_t i = 0;
+    while (i < s.size()) {
+        while (i < s.size() && (std::isspace((unsigned char)s[i]) || s[i] == ',')) ++i;
+        size_t j = i;
+        while (j < s.size() && !std::isspace((unsigned char)s[j]) && s[j] != ',') ++j;
+        if (j > i) out.push_back(s.substr(i, j - i));
+        i = j;
+    }
+    return out;
+}
+
+std::string_view trim(std::string_view s) {
+    while (!s.empty() && std::isspace((unsigned char)s.front())) s.remove_prefix(1);
+    while (!s.empty() && std::isspace((unsigned char)s.back())) s.remove_suffix(1);
+    return s;
+}
+
+// The whole (trimmed) string must be the number: "1.5x" is an error rather than 1.5.
+bool parse_number(std::string_view s, double &out) {
+    s = trim(s);
+    if (s.size() > 1 && s[0] == '+' && s[1] != '-') s.remove_prefix(1);  // from_chars rejects '+'
+    auto [end, ec] = std::from_chars(s.data(), s.data() + s.size(), out);
+    return ec == std::errc() && end == s.data() + s.size() && !s.empty();
+}
+
+bool parse_integer(std::string_view s, int64_t &out) {
+    s = trim(s);
+    if (s.size() > 1 && s[0] == '+' && s[1] != '-') s.remove_prefix(1);
+    auto [end, ec] = std::from_chars(s.data(), s.data() + s.size(), out);
+    return ec == std::errc() && end == s.data() + s.size() && !s.empty();
+}
+
+bool iequals(std::string_view a, std::string_view b) {
+    return a.size() == b.size() &&
+           std::equal(a.begin(), a.end(), b.begin(), [](char x, char y) { return std::tolower(x) == std::tolower(y); });
+}
+
+const std::set<std::string_view> kObjectTags = {"shape",   "bsdf",       "texture", "emitter", "sensor", "film",
+                                                "rfilter", "sampler",    "integrator", "medium", "phase", "volume"};
+const std::set<std::string_view> kTransformOps = {"translate", "rotate", "scale", "lookat", "matrix"};
+constexpr int kMaxIncludeDepth = 15;  // Mitsuba's default; also stops include cycles
+const char *kRefTag = "\x01ref";      // placeholder tag of an unresolved <ref>, never a real element name
+
+// One XML file in memory, with the byte offset of each line start for file:line messages.
+struct SourceFile {
+    std::string path, dir;
+    pugi::xml_document doc;
+    std::vector<size_t> line_starts{0};
+
+    int line_of(ptrdiff_t offset) const {
+        return int(std::upper_bound(line_starts.begin(), line_starts.end(), size_t(std::max<ptrdiff_t>(offset, 0))) -
+                   line_starts.begin());
+    }
+    int line_of(pugi::xml_node n) const { return line_of(n.offset_debug()); }
+};
+
+class Parser {
+public:
+    Parser(const std::map<std::string, std::string> &defines, std::string base_dir) : base_dir_(std::move(base_dir)) {
+        for (const auto &[k, v] : defines) add_param(k, v);
+    }
+
+    std::shared_ptr<XmlNode> parse(const std::string &path) {
+        std::shared_ptr<XmlNode> root = parse_file(path, 0);
+        std::set<const XmlNode *> seen;
+        resolve_refs(*root, seen);
+        std::set<const XmlNode *> done, active;
+        check_cycles(*root, done, active);
+        return root;
+    }
+
+private:
+    struct Param {
+        std::string key, value;  // key includes the '$'
+    };
+
+    std::vector<Param> params_;  // longest key first, so "$resx2" is not substituted as "$resx" + "2"
+    std::map<std::string, std::shared_ptr<XmlNode>> ids_;
+    std::string base_dir_;
+
+    void add_param(const std::string &name, const std::string &value) {
+        Param p{"$" + name, value};
+        auto pos = std::find_if(params_.begin(), params_.end(), [&](const Param &q) { return p.key.size() > q.key.size(); });
+        params_.insert(pos, std::move(p));
+    }
+    bool has_param(const std::string &name) const {
+        return std::any_of(params_.begin(), params_.end(), [&](const Param &p) { return p.key == "$" + name; });
+    }
+
+    [[noreturn]] static void fail(const SourceFile &src, pugi::xml_node n, const std::string &problem) {
+        throw SceneError(src.path, src.line_of(n), problem);
+    }
+
+    std::shared_ptr<XmlNode> parse_file(const std::string &path, int depth) {
+        SourceFile src;
+        src.path = path;
+        src.dir = fs::path(path).parent_path().string();
+        std::ifstream in(path, std::ios::binary);
+        if (!in) throw SceneError(path, "cannot open scene file");
+        std::stringstream ss;
+        ss << in.rdbuf();
+        std::string text = ss.str();
+        for (size_t k = 0; k < text.size(); ++k)
+            if (text[k] == '\n') src.line_starts.push_back(k + 1);
+
+        pugi::xml_parse_result result = src.doc.load_buffer(text.data(), text.size());
+        if (!result) throw SceneError(path, src.line_of(result.offset), std::string("malformed XML: ") + result.description());
+
+        pugi::xml_node root_el;
+        for (pugi::xml_node n : src.doc.children()) {
+            if (n.type() != pugi::node_element) continue;
+            if (root_el) fail(src, n, "more than one root element");
+            root_el = n;
+        }
+        if (!root_el) throw SceneError(path, "no root element");
+        return parse_root(src, root_el, depth);
+    }
+
+    std::shared_ptr<XmlNode> parse_root(const SourceFile &src, pugi::xml_node el, int depth) {
+        substitute(src, el);
+        std::string_view tag = el.name();
+        if (tag != "scene" && !kObjectTags.count(tag)) fail(src, el, "root element <" + std::string(tag) + "> is not a scene or object");
+        check_attributes(src, el, {"!version", "type", "id", "name"});
+        std::string version = el.attribute("version").value();
+        int64_t major = 0;
+        size_t dot = version.find('.');
+        if (!parse_integer(std::string_view(version).substr(0, dot), major))
+            fail(src, el, "invalid version number \"" + version + "\"");
+        // Mitsuba renames 0.x/1.x properties (camelCase) when loading such files; we do not.
+        if (major < 2) fail(src, el, "scene version " + version + " is not supported: convert it to Mitsuba 3 (version 3.0.0)");
+        if (tag != "scene" && !el.attribute("type")) fail(src, el, "missing required attribute \"type\" in <" + std::string(tag) + ">");
+        return make_object(src, el, depth);
+    }
+
+    // Mitsuba substitutes $name in every attribute of every element, longest parameter name first;
+    // "\$" escapes a literal dollar sign.
+    void substitute(const SourceFile &src, pugi::xml_node el) {
+        for (pugi::xml_attribute attr : el.attributes()) {
+            std::string value = attr.value();
+            if (value.find('$') == std::string::npos) continue;
+            for (const Param &p : params_) {
+                for (size_t pos = value.find(p.key); pos != std::string::npos; pos = value.find(p.key, pos)) {
+                    if (pos > 0 && value[pos - 1] == '\\') {
+                        pos += p.key.size();
+                        continue;
+                    }
+                    value.replace(pos, p.key.size(), p.value);
+                    pos += p.value.size();
+                }
+            }
+            for (size_t pos = value.find('$'); pos != std::string::npos; pos = value.find('$', pos + 1)) {
+                if (pos > 0 && value[pos - 1] == '\\') continue;
+                size_t end = pos + 1;
+                while (end < value.size() && (std::isalnum((unsigned char)value[end]) || value[end] == '_')) ++end;
+                fail(src, el, "undefined parameter $" + value.substr(pos + 1, end - pos - 1) + " in attribute \"" +
+                                  attr.name() + "\" (give it a <default> or define it with -D)");
+            }
+            for (size_t pos = value.find("\\$"); pos != std::string::npos; pos = value.find("\\$", pos + 1))
+                value.erase(pos, 1);
+            attr.set_value(value.c_str());
+        }
+    }
+
+    // Unknown attributes are errors, as in Mitsuba: a typo must not be silently ignored.
+    // Names starting with '!' are required.
+    static void check_attributes(const SourceFile &src, pugi::xml_node el, std::initializer_list<std::string_view> allowed) {
+        for (pugi::xml_attribute attr : el.attributes()) {
+            bool ok = std::any_of(allowed.begin(), allowed.end(), [&](std::string_view a) {
+                return (a[0] == '!' ? a.substr(1) : a) == attr.name();
+            });
+            if (!ok) fail(src, el, "unexpected attribute \"" + std::string(attr.name()) + "\" in <" + el.name() + ">");
+        }
+        for (std::string_view a : allowed)
+            if (a[0] == '!' && !el.attribute(std::string(a.substr(1)).c_str()))
+                fail(src, el, "missing required attribute \"" + std::string(a.substr(1)) + "\" in <" + el.name() + ">");
+    }
+
+    std::shared_ptr<XmlNode> make_object(const SourceFile &src, pugi::xml_node el, int depth) {
+        auto node = std::make_shared<XmlNode>();
+        // Mitsuba treats <spectrum type="..."> as a texture plugin.
+        node->tag = std::string_view(el.name()) == "spectrum" ? "texture" : el.name();
+        node->type = el.attribute("type") ? el.attribute("type").value() : "scene";
+        node->id = el.attribute("id").value();
+        node->name = el.attribute("name").value();
+        node->file = src.path;
+        node->line = src.line_of(el);
+        node->base_dir = base_dir_;
+        if (!node->id.empty()) {
+            auto [it, inserted] = ids_.emplace(node->id, node);
+            if (!inserted)
+                fail(src, el, "duplicate id \"" + node->id + "\" (first declared at " + it->second->file + ":" +
+                                  std::to_string(it->second->line) + ")");
+        }
+        for (pugi::xml_node c : el.children())
+            if (c.type() == pugi::node_element) parse_element(src, c, *node, depth);
+        return node;
+    }
+
+    static void claim_name(const SourceFile &src, pugi::xml_node el, const XmlNode &parent, const std::string &name) {
+        if (name.empty()) return;
+        if (parent.props.count(name) || std::count(parent.child_names.begin(), parent.child_names.end(), name))
+            fail(src, el, "\"" + name + "\" is specified more than once in <" + parent.tag + ">");
+    }
+
+    void add_child(const SourceFile &src, pugi::xml_node el, XmlNode &parent, std::shared_ptr<XmlNode> child,
+                   const std::string &name) {
+        claim_name(src, el, parent, name);
+        parent.children.push_back(std::move(child));
+        parent.child_names.push_back(name);
+    }
+
+    void set_prop(const SourceFile &src, pugi::xml_node el, XmlNode &parent, XmlProperty p) {
+        std::string name = el.attribute("name").value();
+        claim_name(src, el, parent, name);
+        p.line = src.line_of(el);
+        parent.props.emplace(name, std::move(p));
+    }
+
+    double number(const SourceFile &src, pugi::xml_node el, std::string_view text, const char *what) {
+        double v;
+        if (!parse_number(text, v))
+            fail(src, el, "could not parse " + std::string(what) + " value \"" + std::string(text) + "\" in <" + el.name() + ">");
+        return v;
+    }
+
+    Vec3 three_numbers(const SourceFile &src, pugi::xml_node el, const char *attr) {
+        auto tokens = tokenize(el.attribute(attr).value());
+        if (tokens.size() != 3)
+            fail(src, el, "attribute \"" + std::string(attr) + "\" of <" + el.name() + "> needs 3 values, got " +
+                              std::to_string(tokens.size()));
+        return Vec3(float(number(src, el, tokens[0], "floating point")), float(number(src, el, tokens[1], "floating point")),
+                    float(number(src, el, tokens[2], "floating point")));
+    }
+
+    // value="v" or value="x y z", or separate x/y/z attributes (missing ones take `def`).
+    Vec3 xyz(const SourceFile &src, pugi::xml_node el, float def, bool require_all) {
+        pugi::xml_attribute value = el.attribute("value");
+        if (value) {
+            if (el.attribute("x") || el.attribute("y") || el.attribute("z"))
+                fail(src, el, "<" + std::string(el.name()) + "> cannot mix \"value\" with \"x\"/\"y\"/\"z\"");
+            auto tokens = tokenize(value.value());
+            if (tokens.size() == 1) return Vec3(float(number(src, el, tokens[0], "floating point")));
+            if (tokens.size() != 3)
+                fail(src, el, "\"value\" of <" + std::string(el.name()) + "> must have 1 or 3 elements, got " +
+                                  std::to_string(tokens.size()));
+            return three_numbers(src, el, "value");
+        }
+        Vec3 v(def);
+        const char *names[3] = {"x", "y", "z"};
+        for (int k = 0; k < 3; ++k) {
+            pugi::xml_attribute a = el.attribute(names[k]);
+            if (a) v[k] = float(number(src, el, a.value(), "floating point"));
+            else if (require_all)
+                fail(src, el, "missing required attribute \"" + std::string(names[k]) + "\" in <" + el.name() + ">");
+        }
+        return v;
+    }
+
+    static void reject_children(const SourceFile &src, pugi::xml_node el) {
+        for (pugi::xml_node c : el.children())
+            if (c.type() == pugi::node_element)
+                fail(src, c, "<" + std::string(c.name()) + "> cannot be nested in the property <" + el.name() + ">");
+    }
+
+    void parse_element(const SourceFile &src, pugi::xml_node el, XmlNode &parent, int depth) {
+        substitute(src, el);
+        std::string_view tag = el.name();
+        XmlProperty p;
+
+        if (kObjectTags.count(tag) || (tag == "spectrum" && el.attribute("type"))) {
+            check_attributes(src, el, {"!type", "id", "name"});
+            add_child(src, el, parent, make_object(src, el, depth), el.attribute("name").value());
+            return;
+        }
+        if (tag == "transform") {
+            check_attributes(src, el, {"!name"});
+            p.kind = Kind::Transform;
+            for (pugi::xml_node op : el.children())
+                if (op.type() == pugi::node_element) p.xf = transform_op(src, op) * p.xf;
+            set_prop(src, el, parent, std::move(p));
+            return;
+        }
+        reject_children(src, el);
+        if (tag == "integer") {
+            check_attributes(src, el, {"!name", "!value"});
+            p.kind = Kind::Integer;
+            if (!parse_integer(el.attribute("value").value(), p.i))
+                fail(src, el, "could not parse integer value \"" + std::string(el.attribute("value").value()) + "\"");
+        } else if (tag == "float") {
+            check_attributes(src, el, {"!name", "!value"});
+            p.kind = Kind::Float;
+            p.f = number(src, el, el.attribute("value").value(), "floating point");
+        } else if (tag == "boolean") {
+            check_attributes(src, el, {"!name", "!value"});
+            p.kind = Kind::Boolean;
+            std::string_view v = trim(el.attribute("value").value());
+            if (!iequals(v, "true") && !iequals(v, "false"))
+                fail(src, el, "could not parse boolean value \"" + std::string(v) + "\": must be \"true\" or \"false\"");
+            p.b = iequals(v, "true");
+        } else if (tag == "string") {
+            check_attributes(src, el, {"!name", "!value"});
+            p.s = el.attribute("value").value();
+        } else if (tag == "rgb") {
+            check_attributes(src, el, {"!name", "!value"});
+            p.kind = Kind::RGB;
+            auto tokens = tokenize(el.attribute("value").value());
+            if (tokens.size() == 1) p.v = Vec3(float(number(src, el, tokens[0], "RGB")));
+            else if (tokens.size() == 3) p.v = three_numbers(src, el, "value");
+            else fail(src, el, "<rgb> needs one or three values, got " + std::to_string(tokens.size()));
+        } else if (tag == "spectrum") {
+            check_attributes(src, el, {"!name", "value", "filename"});
+            p.kind = Kind::RGB;
+            auto tokens = tokenize(el.attribute("value").value());
+            // Wavelength:value pairs and spectrum files need a spectral-to-RGB conversion we lack.
+            if (el.attribute("filename") || tokens.size() != 1 || tokens[0].find(':') != std::string_view::npos)
+                fail(src, el, "only a constant <spectrum value=\"x\"> is supported (use <rgb> instead)");
+            p.v = Vec3(float(number(src, el, tokens[0], "spectrum")));
+        } else if (tag == "vector" || tag == "point") {
+            check_attributes(src, el, {"!name", "value", "x", "y", "z"});
+            p.kind = tag == "vector" ? Kind::Vector : Kind::Point;
+            p.v = xyz(src, el, 0.f, true);
+        } else if (tag == "ref") {
+            check_attributes(src, el, {"!id", "name"});
+            // Resolved once the whole file is read: Mitsuba resolves references by id after parsing.
+            auto placeholder = std::make_shared<XmlNode>();
+            placeholder->tag = kRefTag;
+            placeholder->id = el.attribute("id").value();
+            placeholder->file = src.path;
+            placeholder->line = src.line_of(el);
+            add_child(src, el, parent, placeholder, el.attribute("name").value());
+            return;
+        } else if (tag == "default") {
+            check_attributes(src, el, {"!name", "!value"});
+            std::string name = el.attribute("name").value();
+            if (name.empty()) fail(src, el, "<default> needs a non-empty name");
+            if (!has_param(name)) add_param(name, el.attribute("value").value());
+            return;
+        } else if (tag == "alias") {
+            check_attributes(src, el, {"!id", "!as"});
+            std::string from = el.attribute("id").value(), to = el.attribute("as").value();
+            auto it = ids_.find(from);
+            if (it == ids_.end()) fail(src, el, "<alias>: unknown id \"" + from + "\"");
+            if (!ids_.emplace(to, it->second).second) fail(src, el, "<alias>: id \"" + to + "\" already exists");
+            return;
+        } else if (tag == "include") {
+            check_attributes(src, el, {"!filename", "name"});
+            include(src, el, parent, depth);
+            return;
+        } else if (kTransformOps.count(tag)) {
+            fail(src, el, "<" + std::string(tag) + "> can only appear inside a <transform>");
+        } else {
+            fail(src, el, "unknown element <" + std::string(tag) + ">");
+        }
+        set_prop(src, el, parent, std::move(p));
+    }
+
+    // One step of a <transform>; the caller applies it after (to the left of) the steps before it.
+    Transform transform_op(const SourceFile &src, pugi::xml_node op) {
+        substitute(src, op);
+        reject_children(src, op);
+        std::string_view tag = op.name();
+        if (tag == "translate") {
+            check_attributes(src, op, {"value", "x", "y", "z"});
+            return Transform::translate(xyz(src, op, 0.f, false));
+        }
+        if (tag == "scale") {
+            check_attributes(src, op, {"value", "x", "y", "z"});
+            return Transform::scale(xyz(src, op, 1.f, false));
+        }
+        if (tag == "rotate") {
+            check_attributes(src, op, {"!angle", "value", "x", "y", "z"});
+            Vec3 axis = xyz(src, op, 0.f, false);
+            if (axis == Vec3(0.f)) fail(src, op, "<rotate> axis cannot be zero");
+            return Transform::rotate(axis, float(number(src, op, op.attribute("angle").value(), "angle")));
+        }
+        if (tag == "lookat") {
+            check_attributes(src, op, {"!origin", "!target", "up"});
+            Vec3 origin = three_numbers(src, op, "origin"), target = three_numbers(src, op, "target");
+            Vec3 up = op.attribute("up") ? three_numbers(src, op, "up") : Vec3(0.f);
+            // Mitsuba picks an arbitrary perpendicular up vector when none is given.
+            if (up == Vec3(0.f) && !(origin == target)) up = Frame(normalize(target - origin)).s;
+            try {
+                if (origin == target) throw std::runtime_error("origin equals target");
+                return Transform::look_at(origin, target, up);
+            } catch (const std::exception &e) {
+                fail(src, op, std::string("invalid <lookat>: ") + e.what());
+            }
+        }
+        if (tag == "matrix") {
+            check_attributes(src, op, {"!value"});
+            auto tokens = tokenize(op.attribute("value").value());
+            if (tokens.size() != 16 && tokens.size() != 9)
+                fail(src, op, "<matrix> needs 9 or 16 values, got " + std::to_string(tokens.size()));
+            int n = tokens.size() == 16 ? 4 : 3;
+            Matrix4 m = Matrix4::identity();
+            for (int r = 0; r < n; ++r)
+                for (int c = 0; c < n; ++c) m.m[r][c] = float(number(src, op, tokens[r * n + c], "matrix"));
+            try {
+                return Transform(m);
+            } catch (const std::exception &e) {
+                fail(src, op, std::string("<matrix> is not invertible: ") + e.what());
+            }
+        }
+        fail(src, op, "unexpected <" + std::string(tag) + "> inside <transform>");
+    }
+
+    void include(const SourceFile &src, pugi::xml_node el, XmlNode &parent, int depth) {
+        if (depth + 1 >= kMaxIncludeDepth) fail(src, el, "<include> nested too deeply (is a file including itself?)");
+        fs::path file(el.attribute("filename").value());
+        if (file.is_relative()) file = fs::path(src.dir) / file;
+        if (!fs::exists(file)) fail(src, el, "included file \"" + file.string() + "\" not found");
+        std::shared_ptr<XmlNode> root = parse_file(file.lexically_normal().string(), depth + 1);
+        if (root->tag != "scene") {
+            add_child(src, el, parent, root, el.attribute("name").value());
+            return;
+        }
+        // An included <scene> contributes its objects; like Mitsuba, its plain properties are dropped.
+        for (size_t k = 0; k < root->children.size(); ++k)
+            add_child(src, el, parent, root->children[k], root->child_names[k]);
+    }
+
+    void resolve_refs(XmlNode &node, std::set<const XmlNode *> &seen) {
+        if (!seen.insert(&node).second) return;
+        for (auto &c : node.children) {
+            if (c->tag == kRefTag) {
+                auto it = ids_.find(c->id);
+                if (it == ids_.end()) throw SceneError(c->file, c->line, "<ref>: unknown id \"" + c->id + "\"");
+                c = it->second;
+            }
+            resolve_refs(*c, seen);
+        }
+    }
+
+    // A <ref> to an enclosing object would make the factory recurse forever.
+    void check_cycles(const XmlNode &node, std::set<const XmlNode *> &done, std::set<const XmlNode *> &active) {
+        if (done.count(&node)) return;
+        if (!active.insert(&node).second) throw node.error("object \"" + node.id + "\" contains itself through a <ref>");
+        for (const auto &c : node.children) check_cycles(*c, done, active);
+        active.erase(&node);
+        done.insert(&node);
+    }
+};
+
+}  // namespace
+
+std::shared_ptr<XmlNode> parse_mitsuba_xml(const std::string &path, const std::map<std::string, std::string> &defines) {
+    // Like Mitsuba's file resolver, relative file names resolve against the top-level scene's folder
+    // (also for objects from included files).
+    std::string dir = fs::absolute(fs::path(path)).parent_path().lexically_normal().string();
+    return Parser(defines, dir).parse(path);
+}
+
+}  // namespace neepp

@@ -1,0 +1,87 @@
+// Mitsuba 3 XML scene files parsed into a generic tree of nodes with typed properties. A separate
+// factory turns the tree into renderer objects; this layer only knows the file format.
+#pragma once
+#include <cstdint>
+#include <map>
+#include <memory>
+#include <string>
+#include <vector>
+#include "neepp/io/scene_error.h"
+#include "neepp/math/transform.h"
+
+namespace neepp {
+
+struct XmlProperty {
+    // <spectrum value="x"> (a constant) is stored as RGB: the renderer works in RGB, like Mitsuba's
+    // *_rgb variants.
+    enum class Kind { Integer, Float, Boolean, String, RGB, Vector, Point, Transform };
+    Kind kind = Kind::String;
+    int64_t i = 0;
+    double f = 0;
+    bool b = false;
+    std::string s;
+    Vec3 v;  // RGB, Vector and Point
+    Transform xf;
+    int line = 0;
+    mutable bool used = false;  // set by XmlNode's getters, so unread properties can be reported
+};
+
+const char *kind_name(XmlProperty::Kind kind);
+
+struct XmlNode {
+    std::string tag;   // shape, bsdf, texture, emitter, sensor, film, rfilter, sampler, integrator, medium, ...
+    std::string type;  // the plugin name, e.g. "obj"; "scene" for the root <scene>
+    std::string id;    // empty when the element has no id
+    std::string name;  // the element's own name attribute, e.g. "reflectance" for a nested texture
+    std::string file;  // the XML file the element was read from, for messages
+    int line = 0;
+    std::string base_dir;  // directory that relative `filename` values are resolved against
+    std::map<std::string, XmlProperty> props;
+    // Nested objects in document order. A <ref> puts the referenced node itself here, so an object
+    // used by many others is one shared node.
+    std::vector<std::shared_ptr<XmlNode>> children;
+    // The name each child was given where it was used: the element's name attribute, or the name
+    // attribute of the <ref> that brought it in (empty when none). Parallel to `children`.
+    std::vector<std::string> child_names;
+
+    bool has(const std::string &prop) const { return props.count(prop) != 0; }
+
+    // Getters with a default return it when the property is absent; the others throw when it is
+    // absent. All throw a SceneError naming file:line and the property on a type mismatch.
+    float get_float(const std::string &prop) const;
+    float get_float(const std::string &prop, float def) const;  // an integer is accepted too
+    int get_int(const std::string &prop) const;
+    int get_int(const std::string &prop, int def) const;
+    bool get_bool(const std::string &prop) const;
+    bool get_bool(const std::string &prop, bool def) const;
+    std::string get_string(const std::string &prop) const;
+    std::string get_string(const std::string &prop, const std::string &def) const;
+    Color get_rgb(const std::string &prop) const;  // rgb, constant spectrum, or float (grey)
+    Color get_rgb(const std::string &prop, const Color &def) const;
+    Vec3 get_vector(const std::string &prop) const;  // <vector> or <point>
+    Vec3 get_vector(const std::string &prop, const Vec3 &def) const;
+    Transform get_transform(const std::string &prop, const Transform &def = Transform()) const;
+
+    // The nested object given under `child_name` (e.g. texture "reflectance"); null when none.
+    std::shared_ptr<XmlNode> child(const std::string &child_name) const;
+    // Nested objects with the given tag (e.g. all "bsdf" children), in document order.
+    std::vector<std::shared_ptr<XmlNode>> children_with_tag(const std::string &child_tag) const;
+
+    // `path` made absolute against the scene file's directory (unchanged when already absolute).
+    std::string resolve_path(const std::string &path) const;
+    // Properties no getter has read yet, so the factory can warn about misspelt or unsupported ones.
+    std::vector<std::string> unused_properties() const;
+    // An error located at this element: "file:line: <tag type="..."> problem".
+    SceneError error(const std::string &problem) const;
+
+private:
+    // Marks the property used; null when absent and not required.
+    const XmlProperty *find(const std::string &prop, bool required) const;
+};
+
+// Parses a Mitsuba 3 scene file. `defines` are the -D name=value parameters; they take precedence
+// over the file's <default> values. Throws SceneError (file:line: problem) on any error.
+std::shared_ptr<XmlNode> parse_mitsuba_xml(const std::string &path,
+                                           const std::map<std::string, std::string> &defines = {});
+
+}  // namespace neepp

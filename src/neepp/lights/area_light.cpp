@@ -1,0 +1,34 @@
+#include "neepp/lights/area_light.h"
+
+namespace neepp {
+
+DirectionSample AreaLight::sample_direction(const Vec3 &ref, Vec2 u, Color &radiance) const {
+    PositionSample ps = shape_->sample_position(u);
+    DirectionSample ds;
+    ds.p = ps.p;
+    ds.n = ps.n;
+    Vec3 d = ps.p - ref;
+    float dist2 = squared_norm(d);
+    ds.dist = std::sqrt(dist2);
+    ds.d = d / ds.dist;
+    float cos_light = -dot(ds.n, ds.d);  // one-sided: only the front face emits
+    radiance = Color(0.f);
+    if (cos_light <= 0 || !(dist2 > 0)) return ds;
+    ds.pdf = ps.pdf * dist2 / cos_light;
+    SurfaceInteraction si;
+    si.p = ps.p; si.n = ps.n; si.uv = ps.uv;
+    radiance = radiance_->eval(si);
+    return ds;
+}
+
+float AreaLight::pdf_direction(const Vec3 &ref, const DirectionSample &ds) const {
+    float cos_light = -dot(ds.n, ds.d);
+    if (cos_light <= 0) return 0.f;
+    return shape_->pdf_position() * ds.dist * ds.dist / cos_light;
+}
+
+Color AreaLight::eval_surface(const SurfaceInteraction &si, const Vec3 &w) const {
+    return dot(si.n, w) > 0 ? radiance_->eval(si) : Color(0.f);
+}
+
+}  // namespace neepp

@@ -1,0 +1,124 @@
+#include "neepp/lights/environment_light.h"
+
+#include <stdexcept>
+#include "neepp/math/warp.h"
+
+namespace neepp {
+
+EnvironmentMapLight::EnvironmentMapLight(Image image, const Transform &to_world, float scale)
+    : image_(std::move(image)), to_world_(to_world), scale_(scale) {
+    if (image_.width < 2 || image_.height < 2) throw std::runtime_error("envmap: image too small");
+    int w = image_.width, h = image_.height;
+    // Sampling density ∝ luminance × sin(theta) of the row (the equirectangular area element), so the
+    // directional pdf stays bounded near the poles. Each cell's weight uses the bilinear lookups' maximum
+    // neighbourhood by averaging the cell corners, so no cell with radiance gets zero probability.
+    std::vector<float> weights(size_t(w) * h);
+    double sum = 0;
+    for (int y = 0; y < h; ++y) {
+        float sin_theta = std::sin(kPi * (float(y) + 0.5f) / float(h));
+        for (int x = 0; x < w; ++x) {
+            float lum = 0;
+            for (int dy = 0; dy <= 1; ++dy)
+                for (int dx = 0; dx <= 1; ++dx) {
+                    Vec2 uv((float(x) + float(dx)) / float(w), (float(y) + float(dy)) / float(h));
+                    lum = std::max(lum, luminance(lookup(uv)));
+                }
+            weights[size_t(y) * w + x] = std::max(lum, 0.f) * sin_theta;
+            Color c = image_.rgb(x, y);
+            sum += double(luminance(c)) * sin_theta;
+        }
+    }
+    distribution_ = Distribution2D(weights, w, h);
+    // Mean radiance over the sphere (for power): integrate with the sin(theta) measure.
+    Color acc(0.f);
+    double norm_w = 0;
+    for (int y = 0; y < h; ++y) {
+        float sin_theta = std::sin(kPi * (float(y) + 0.5f) / float(h));
+        for (int x = 0; x < w; ++x) acc += image_.rgb(x, y) * sin_theta;
+        norm_w += double(sin_theta) * w;
+    }
+    mean_radiance_ = acc * float(scale_ / norm_w);
+    (void)sum;
+}
+
+Vec2 EnvironmentMapLight::direction_to_uv(const Vec3 &d_world) const {
+    Vec3 v = normalize(to_world_.inverse().vector(d_world));
+    float u = std::atan2(v.x, -v.z) * kInv2Pi;
+    if (u < 0) u += 1.f;
+    float vv = std::acos(std::clamp(v.y, -1.f, 1.f)) * kInvPi;
+    return {u, vv};
+}
+
+Vec3 EnvironmentMapLight::uv_to_direction(Vec2 uv) const {
+    float theta = uv.y * kPi, phi = uv.x * 2.f * kPi;
+    float st = std::sin(theta);
+    Vec3 local(st * std::sin(phi), std::cos(theta), -st * std::cos(phi));
+    return normalize(to_world_.vector(local));
+}
+
+// Bilinear lookup with Mitsuba's envmap convention: texel (i, j) sits at u = i / W (the map wraps
+// horizontally) and v = j / (H - 1) (the first and last rows lie on the poles).
+Color EnvironmentMapLight::lookup(Vec2 uv) const {
+    int w = image_.width, h = image_.height;
+    float x = uv.x * float(w), y = uv.y * float(h - 1);
+    int x0 = int(std::floor(x)), y0 = std::clamp(int(std::floor(y)), 0, h - 1);
+    float fx = x - float(x0), fy = std::clamp(y - float(y0), 0.f, 1.f);
+    x0 = ((x0 % w) + w) % w;
+    int x1 = (x0 + 1) % w, y1 = std::min(y0 + 1, h - 1);
+    Color c = image_.rgb(x0, y0) * ((1 - fx) * (1 - fy)) + image_.rgb(x1, y0) * (fx * (1 - fy)) +
+              image_.rgb(x0, y1) * ((1 - fx) * fy) + image_.rgb(x1, y1) * (fx * fy);
+    return c;
+}
+
+Color EnvironmentMapLight::eval_environment(const Vec3 &d) const { return lookup(direction_to_uv(d)) * scale_; }
+
+DirectionSample EnvironmentMapLight::sample_direction(const Vec3 &ref, Vec2 u, Color &radiance) const {
+    float pdf_uv;
+    Vec2 uv = distribution_.sample(u, &pdf_uv);
+    DirectionSample ds;
+    radiance = Color(0.f);
+    float sin_theta = std::sin(uv.y * kPi);
+    if (pdf_uv <= 0 || sin_theta <= 0) return ds;
+    ds.d = uv_to_direction(uv);
+    ds.pdf = pdf_uv / (2.f * kPi * kPi * sin_theta);
+    ds.dist = kInfinity;
+    ds.p = ref + ds.d * (4.f * scene_radius_);
+    radiance = lookup(uv) * scale_;
+    return ds;
+}
+
+float EnvironmentMapLight::pdf_direction(const Vec3 &, const DirectionSample &ds) const {
+    Vec2 uv = direction_to_uv(ds.d);
+    float sin_theta = std::sin(uv.y * kPi);
+    if (sin_theta <= 0) return 0.f;
+    return distribution_.pdf(uv) / (2.f * kPi * kPi * sin_theta);
+}
+
+Color EnvironmentMapLight::power() const {
+    return mean_radiance_ * (kPi * 4.f * kPi * scene_radius_ * scene_radius_);
+}
+
+DirectionSample ConstantEnvironmentLight::sample_direction(const Vec3 &ref, Vec2 u, Color &radiance) const {
+    DirectionSample ds;
+    ds.d = square_to_uniform_sphere(u);
+    ds.pdf = kInv4Pi;
+    ds.dist = kInfinity;
+    ds.p = ref + ds.d * (4.f * scene_radius_);
+    radiance = radiance_;
+    return ds;
+}
+
+DirectionSample PointLight::sample_direction(const Vec3 &ref, Vec2, Color &radiance) const {
+    DirectionSample ds;
+    Vec3 d = position_ - ref;
+    float dist2 = squared_norm(d);
+    ds.p = position_;
+    ds.dist = std::sqrt(dist2);
+    ds.d = d / ds.dist;
+    ds.pdf = 1.f;
+    ds.delta = true;
+    radiance = intensity_ / dist2;  // arriving radiance-equivalent: I / r^2 (the pdf is 1 for the delta)
+    return ds;
+}
+
+}  // namespace neepp

@@ -1,0 +1,66 @@
+// Environment lights: Mitsuba's `envmap` (equirectangular, importance-sampled by luminance) and
+// `constant` (uniform radiance from every direction).
+#pragma once
+#include "neepp/io/image.h"
+#include "neepp/lights/light.h"
+#include "neepp/math/distribution.h"
+#include "neepp/math/transform.h"
+
+namespace neepp {
+
+class EnvironmentMapLight final : public Light {
+public:
+    // `image` in linear RGB; `to_world` orients the map (Mitsuba: +y is the map's up, u = 0 faces -z).
+    EnvironmentMapLight(Image image, const Transform &to_world, float scale);
+    DirectionSample sample_direction(const Vec3 &ref, Vec2 u, Color &radiance) const override;
+    float pdf_direction(const Vec3 &ref, const DirectionSample &ds) const override;
+    Color eval_environment(const Vec3 &d) const override;
+    Color power() const override;
+    bool is_infinite() const override { return true; }
+    void set_scene_bounds(const BBox &b) override { scene_radius_ = std::max(1e-3f, 0.5f * norm(b.extent())); }
+
+    // Map between world directions and the map's (u, v) in [0,1)^2 (v = 0 at the top, the +y pole).
+    Vec2 direction_to_uv(const Vec3 &d) const;
+    Vec3 uv_to_direction(Vec2 uv) const;
+
+private:
+    Color lookup(Vec2 uv) const;
+    Image image_;
+    Transform to_world_;
+    float scale_;
+    Distribution2D distribution_;
+    Color mean_radiance_;
+    float scene_radius_ = 1.f;
+};
+
+class ConstantEnvironmentLight final : public Light {
+public:
+    explicit ConstantEnvironmentLight(Color radiance) : radiance_(radiance) {}
+    DirectionSample sample_direction(const Vec3 &ref, Vec2 u, Color &radiance) const override;
+    float pdf_direction(const Vec3 &, const DirectionSample &) const override { return kInv4Pi; }
+    Color eval_environment(const Vec3 &) const override { return radiance_; }
+    Color power() const override { return radiance_ * (kPi * 4.f * kPi * scene_radius_ * scene_radius_); }
+    bool is_infinite() const override { return true; }
+    void set_scene_bounds(const BBox &b) override { scene_radius_ = std::max(1e-3f, 0.5f * norm(b.extent())); }
+
+private:
+    Color radiance_;
+    float scene_radius_ = 1.f;
+};
+
+// Mitsuba's `point` light: `intensity` in W/sr at `position`.
+class PointLight final : public Light {
+public:
+    PointLight(Vec3 position, Color intensity) : position_(position), intensity_(intensity) {}
+    DirectionSample sample_direction(const Vec3 &ref, Vec2 u, Color &radiance) const override;
+    float pdf_direction(const Vec3 &, const DirectionSample &) const override { return 0.f; }
+    Color power() const override { return intensity_ * (4.f * kPi); }
+    bool is_delta() const override { return true; }
+    Vec3 position() const { return position_; }
+
+private:
+    Vec3 position_;
+    Color intensity_;
+};
+
+}  // namespace neepp

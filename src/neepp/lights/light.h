@@ -1,0 +1,62 @@
+// The light interface: area lights on shapes, environment maps, constant environments and point lights.
+#pragma once
+#include <cstdint>
+#include <memory>
+#include "neepp/math/bbox.h"
+#include "neepp/scene/interaction.h"
+
+namespace neepp {
+
+// A point on a light as seen from a reference point: where, which way, how likely.
+struct DirectionSample {
+    Vec3 p;              // point on the light (for infinite lights: a point far away along d)
+    Vec3 n;              // light surface normal at p (zero for point and infinite lights)
+    Vec3 d;              // unit direction from the reference point toward the light
+    float dist = 0;      // distance to p (infinite for environment lights)
+    float pdf = 0;       // solid-angle density at the reference point (1 for delta lights)
+    bool delta = false;  // sampled from a delta distribution (point light): not reachable by BSDF sampling
+};
+
+class Light {
+public:
+    virtual ~Light() = default;
+    // Samples a direction toward the light from ref. Returns the emitted radiance arriving at ref along
+    // -d, ignoring occlusion, via `radiance` (zero when the sample is invalid, e.g. the back of an area light).
+    virtual DirectionSample sample_direction(const Vec3 &ref, Vec2 u, Color &radiance) const = 0;
+    // Solid-angle density with which sample_direction would have produced ds from ref (0 for delta lights).
+    virtual float pdf_direction(const Vec3 &ref, const DirectionSample &ds) const = 0;
+    // Radiance leaving a point of an area light toward direction w (world, pointing away from the light).
+    virtual Color eval_surface(const SurfaceInteraction &si, const Vec3 &w) const { return Color(0.f); }
+    // Radiance arriving from an infinite light along direction d (world, pointing from the scene to the sky).
+    virtual Color eval_environment(const Vec3 &d) const { return Color(0.f); }
+    // Total emitted power, used by the power light sampler (up to a constant common to all lights).
+    virtual Color power() const = 0;
+    virtual bool is_infinite() const { return false; }
+    virtual bool is_delta() const { return false; }
+    // Called once the scene bounds are known (infinite lights need them for power and sample points).
+    virtual void set_scene_bounds(const BBox &) {}
+
+    uint32_t index = 0;  // position in Scene::lights, for light samplers' tables
+};
+
+using LightPtr = std::unique_ptr<Light>;
+
+// Builds a DirectionSample for a point found by tracing a ray from ref (a BSDF-sampled hit on an area
+// light, or a miss for an environment), so pdf_direction can be asked for its MIS weight.
+inline DirectionSample direction_sample_from_hit(const Vec3 &ref, const SurfaceInteraction &si) {
+    DirectionSample ds;
+    ds.p = si.p;
+    ds.n = si.n;
+    Vec3 d = si.p - ref;
+    ds.dist = norm(d);
+    ds.d = ds.dist > 0 ? d / ds.dist : Vec3(0, 0, 1);
+    return ds;
+}
+inline DirectionSample direction_sample_from_miss(const Vec3 &d) {
+    DirectionSample ds;
+    ds.d = d;
+    ds.dist = kInfinity;
+    return ds;
+}
+
+}  // namespace neepp

@@ -1,0 +1,61 @@
+// Light selection for next event estimation. The one interface every strategy implements:
+// sample(ctx, u) -> (light, pmf) and pmf(ctx, light), where pmf must be exactly reproducible from
+// (ctx, light) alone because MIS needs it when a BSDF-sampled ray hits a light.
+#pragma once
+#include <memory>
+#include <string>
+#include <vector>
+#include "neepp/lights/light.h"
+#include "neepp/math/distribution.h"
+
+namespace neepp {
+
+// What a light sampler may know about the shading point.
+struct LightSampleContext {
+    Vec3 p;
+    Vec3 n;  // geometric normal (zero for a point in a medium)
+};
+
+struct SampledLight {
+    const Light *light = nullptr;
+    float pmf = 0;
+};
+
+class LightSampler {
+public:
+    virtual ~LightSampler() = default;
+    virtual SampledLight sample(const LightSampleContext &ctx, float u) const = 0;
+    virtual float pmf(const LightSampleContext &ctx, const Light &light) const = 0;
+    virtual std::string name() const = 0;
+};
+
+class UniformLightSampler final : public LightSampler {
+public:
+    explicit UniformLightSampler(std::vector<const Light *> lights) : lights_(std::move(lights)) {}
+    SampledLight sample(const LightSampleContext &, float u) const override;
+    float pmf(const LightSampleContext &, const Light &) const override {
+        return lights_.empty() ? 0.f : 1.f / float(lights_.size());
+    }
+    std::string name() const override { return "uniform"; }
+
+private:
+    std::vector<const Light *> lights_;
+};
+
+// Chooses lights proportionally to their emitted power (luminance of Light::power()).
+class PowerLightSampler final : public LightSampler {
+public:
+    explicit PowerLightSampler(std::vector<const Light *> lights);
+    SampledLight sample(const LightSampleContext &, float u) const override;
+    float pmf(const LightSampleContext &, const Light &light) const override;
+    std::string name() const override { return "power"; }
+
+private:
+    std::vector<const Light *> lights_;
+    Distribution1D distribution_;
+    std::vector<float> pmf_by_index_;  // indexed by Light::index
+};
+
+std::unique_ptr<LightSampler> make_light_sampler(const std::string &name, std::vector<const Light *> lights);
+
+}  // namespace neepp

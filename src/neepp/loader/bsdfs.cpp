@@ -1,0 +1,136 @@
+#include <optional>
+#include "neepp/loader/factories.h"
+#include "neepp/materials/conductor.h"
+#include "neepp/materials/dielectric.h"
+#include "neepp/materials/diffuse.h"
+#include "neepp/materials/ior.h"
+#include "neepp/materials/plastic.h"
+#include "neepp/materials/roughconductor.h"
+#include "neepp/materials/roughplastic.h"
+#include "neepp/materials/thindielectric.h"
+#include "neepp/materials/twosided.h"
+
+namespace neepp::loader {
+namespace {
+
+MicrofacetType distribution_param(const XmlNode &node) {
+    std::string name = node.get_string("distribution", "beckmann");
+    auto t = parse_microfacet_type(name);
+    if (!t) throw node.error("unknown microfacet distribution '" + name + "' (beckmann, ggx)");
+    return *t;
+}
+
+// Mitsuba's conductor parameters: a named `material` or explicit `eta`/`k`.
+std::pair<TexturePtr, TexturePtr> conductor_ior(Factories &f, const XmlNode &node) {
+    std::string material = node.get_string("material", "none");
+    if (node.has("eta") || node.child("eta")) {
+        if (material != "none") throw node.error("give either 'material' or 'eta'/'k', not both");
+        return {f.texture_param(node, "eta", Color(0.f)), f.texture_param(node, "k", Color(1.f))};
+    }
+    auto ior = lookup_conductor_ior(material);
+    if (!ior) throw node.error("unknown conductor material '" + material + "'");
+    return {constant_texture(ior->eta), constant_texture(ior->k)};
+}
+
+}  // namespace
+
+float ior_param(const XmlNode &node, const std::string &name, float def) {
+    if (!node.has(name)) return def;
+    const XmlProperty &p = node.props.at(name);
+    if (p.kind == XmlProperty::Kind::String) {
+        std::string s = node.get_string(name);
+        auto v = lookup_dielectric_ior(s);
+        if (!v) throw node.error("unknown index of refraction '" + s + "' for '" + name + "'");
+        return *v;
+    }
+    float v = node.get_float(name);
+    if (!(v > 0)) throw node.error("'" + name + "' must be positive");
+    return v;
+}
+
+BSDFPtr Factories::default_bsdf() {
+    if (!default_bsdf_) default_bsdf_ = std::make_shared<DiffuseBSDF>(constant_texture(0.5f));
+    return default_bsdf_;
+}
+
+BSDFPtr Factories::bsdf(const XmlNode &node) {
+    if (auto it = bsdfs_.find(&node); it != bsdfs_.end()) return it->second;
+    if (node.tag != "bsdf") throw node.error("expected a <bsdf>, found <" + node.tag + ">");
+    BSDFPtr b;
+    try {
+        b = create_bsdf(node);
+    } catch (const SceneError &) {
+        throw;
+    } catch (const std::exception &e) {  // a constructor's validation, located at its element
+        throw node.error(e.what());
+    }
+    warn_unused(node);
+    bsdfs_[&node] = b;
+    return b;
+}
+
+BSDFPtr Factories::create_bsdf(const XmlNode &node) {
+    const std::string &t = node.type;
+    auto nested = [&](size_t count_min, size_t count_max) {
+        auto kids = node.children_with_tag("bsdf");
+        if (kids.size() < count_min || kids.size() > count_max)
+            throw node.error("needs " + std::to_string(count_min) + (count_max > count_min ? " or " + std::to_string(count_max) : "") +
+                             " nested <bsdf>, found " + std::to_string(kids.size()));
+        return kids;
+    };
+    BSDFPtr b;
+    if (t == "diffuse") {
+        b = std::make_shared<DiffuseBSDF>(texture_param(node, "reflectance", Color(0.5f)));
+    } else if (t == "twosided") {
+        auto kids = nested(1, 2);
+        b = std::make_shared<TwoSidedBSDF>(bsdf(*kids[0]), kids.size() > 1 ? bsdf(*kids[1]) : nullptr);
+    } else if (t == "mask") {
+        auto kids = nested(1, 1);
+        b = std::make_shared<MaskBSDF>(texture_param(node, "opacity", Color(0.5f)), bsdf(*kids[0]));
+    } else if (t == "bumpmap") {
+        auto kids = nested(1, 1);
+        auto tex = node.children_with_tag("texture");
+        if (tex.size() != 1) throw node.error("needs exactly one nested <texture> (the height map)");
+        b = std::make_shared<BumpMapBSDF>(texture(*tex[0]), node.get_float("scale", 1.f), bsdf(*kids[0]));
+    } else if (t == "conductor") {
+        auto [eta, k] = conductor_ior(*this, node);
+        b = std::make_shared<ConductorBSDF>(eta, k, texture_param_or_null(node, "specular_reflectance"));
+    } else if (t == "roughconductor") {
+        auto [eta, k] = conductor_ior(*this, node);
+        TexturePtr au, av;
+        if (node.has("alpha_u") || node.child("alpha_u")) {
+            if (node.has("alpha") || node.child("alpha")) throw node.error("give either 'alpha' or 'alpha_u'/'alpha_v'");
+            au = texture_param(node, "alpha_u", Color(0.1f));
+            av = texture_param(node, "alpha_v", Color(0.1f));
+        } else {
+            au = av = texture_param(node, "alpha", Color(0.1f));
+        }
+        b = std::make_shared<RoughConductorBSDF>(distribution_param(node), au, av, eta, k,
+                                                 texture_param_or_null(node, "specular_reflectance"),
+                                                 node.get_bool("sample_visible", true));
+    } else if (t == "plastic") {
+        b = std::make_shared<PlasticBSDF>(ior_param(node, "int_ior", 1.49f), ior_param(node, "ext_ior", 1.000277f),
+                                          texture_param(node, "diffuse_reflectance", Color(0.5f)),
+                                          texture_param_or_null(node, "specular_reflectance"),
+                                          node.get_bool("nonlinear", false));
+    } else if (t == "roughplastic") {
+        b = std::make_shared<RoughPlasticBSDF>(distribution_param(node), node.get_float("alpha", 0.1f),
+                                               ior_param(node, "int_ior", 1.49f), ior_param(node, "ext_ior", 1.000277f),
+                                               texture_param(node, "diffuse_reflectance", Color(0.5f)),
+                                               texture_param_or_null(node, "specular_reflectance"),
+                                               node.get_bool("nonlinear", false), node.get_bool("sample_visible", true));
+    } else if (t == "dielectric" || t == "thindielectric") {
+        float int_ior = ior_param(node, "int_ior", 1.5046f), ext_ior = ior_param(node, "ext_ior", 1.000277f);
+        TexturePtr r = texture_param_or_null(node, "specular_reflectance");
+        TexturePtr tr = texture_param_or_null(node, "specular_transmittance");
+        if (t == "dielectric") b = std::make_shared<DielectricBSDF>(int_ior, ext_ior, r, tr);
+        else b = std::make_shared<ThinDielectricBSDF>(int_ior, ext_ior, r, tr);
+    } else {
+        throw node.error("unsupported BSDF type '" + t +
+                         "' (supported: diffuse, twosided, mask, bumpmap, conductor, roughconductor, plastic, "
+                         "roughplastic, dielectric, thindielectric)");
+    }
+    return b;
+}
+
+}  // namespace neepp::loader

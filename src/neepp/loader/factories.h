@@ -1,0 +1,36 @@
+// Internal to the loader: builders from XML nodes to renderer objects, sharing one cache so that a node
+// referenced many times (a BSDF used by many shapes) becomes one object.
+#pragma once
+#include <map>
+#include <memory>
+#include "neepp/io/xml_tree.h"
+#include "neepp/materials/bsdf.h"
+#include "neepp/scene/scene.h"
+
+namespace neepp::loader {
+
+class Factories {
+public:
+    TexturePtr texture(const XmlNode &node);
+    // The parameter `name` of node as a texture: a nested texture, an rgb/float/spectrum constant, or def.
+    TexturePtr texture_param(const XmlNode &node, const std::string &name, Color def);
+    TexturePtr texture_param_or_null(const XmlNode &node, const std::string &name);
+    BSDFPtr bsdf(const XmlNode &node);
+    BSDFPtr default_bsdf();
+    // Creates the shape (and its area light, if any) and adds both to the scene.
+    void shape(const XmlNode &node, Scene &scene);
+    void emitter(const XmlNode &node, Scene &scene);
+
+private:
+    BSDFPtr create_bsdf(const XmlNode &node);
+    std::map<const XmlNode *, TexturePtr> textures_;
+    std::map<const XmlNode *, BSDFPtr> bsdfs_;
+    BSDFPtr default_bsdf_;
+};
+
+// Reports properties that no builder read (misspelt or unsupported) on stderr, as Mitsuba does.
+void warn_unused(const XmlNode &node);
+// An IOR given as a number or a name from Mitsuba's table ("bk7", "air"...).
+float ior_param(const XmlNode &node, const std::string &name, float def);
+
+}  // namespace neepp::loader

@@ -1,0 +1,125 @@
+#include "neepp/loader/scene_loader.h"
+
+#include <fmt/core.h>
+#include "neepp/loader/factories.h"
+
+namespace neepp {
+namespace {
+
+std::string property_as_string(const XmlProperty &p) {
+    switch (p.kind) {
+    case XmlProperty::Kind::Integer: return std::to_string(p.i);
+    case XmlProperty::Kind::Float: return fmt::format("{}", p.f);
+    case XmlProperty::Kind::Boolean: return p.b ? "true" : "false";
+    case XmlProperty::Kind::String: return p.s;
+    default: return "";
+    }
+}
+
+void load_film(const XmlNode &film, Scene &scene) {
+    if (film.type != "hdrfilm") throw film.error("unsupported film '" + film.type + "' (supported: hdrfilm)");
+    scene.camera.width = film.get_int("width", 768);
+    scene.camera.height = film.get_int("height", 576);
+    // Mitsuba's film also carries output settings that do not change the image.
+    film.get_string("file_format", "openexr");
+    film.get_string("pixel_format", "rgb");
+    film.get_string("component_format", "float16");
+    film.get_bool("banner", false);
+    constexpr int kMaxSide = 1 << 15;
+    if (scene.camera.width < 1 || scene.camera.height < 1 || scene.camera.width > kMaxSide || scene.camera.height > kMaxSide)
+        throw film.error(fmt::format("film size {}x{} is out of range (1 to {} pixels per side)", scene.camera.width,
+                                     scene.camera.height, kMaxSide));
+    for (const auto &child : film.children) {
+        if (child->tag != "rfilter") throw child->error("unexpected <" + child->tag + "> inside the film");
+        RenderSettings &s = scene.settings;
+        s.rfilter = child->type;
+        if (s.rfilter == "box") s.rfilter_radius = child->get_float("radius", 0.5f);
+        else if (s.rfilter == "tent") s.rfilter_radius = child->get_float("radius", 1.f);
+        else if (s.rfilter == "gaussian") {
+            s.rfilter_stddev = child->get_float("stddev", 0.5f);
+            s.rfilter_radius = 4.f * s.rfilter_stddev;
+        } else {
+            throw child->error("unsupported reconstruction filter '" + s.rfilter + "' (box, tent, gaussian)");
+        }
+        if (!(s.rfilter_radius > 0 && s.rfilter_radius <= 16)) throw child->error("filter radius out of range (0, 16]");
+        loader::warn_unused(*child);
+    }
+    loader::warn_unused(film);
+}
+
+void load_sensor(const XmlNode &sensor, Scene &scene) {
+    if (sensor.type != "perspective") throw sensor.error("unsupported sensor '" + sensor.type + "' (supported: perspective)");
+    PerspectiveCamera &cam = scene.camera;
+    cam.to_world = sensor.get_transform("to_world");
+    cam.fov = sensor.get_float("fov", 39.3077f);
+    cam.fov_axis = sensor.get_string("fov_axis", "x");
+    cam.near_clip = sensor.get_float("near_clip", 1e-2f);
+    cam.far_clip = sensor.get_float("far_clip", 1e4f);
+    for (const auto &child : sensor.children) {
+        if (child->tag == "film") {
+            load_film(*child, scene);
+        } else if (child->tag == "sampler") {
+            scene.settings.sampler = child->type;
+            scene.settings.spp = child->get_int("sample_count", 4);
+            scene.settings.seed = uint64_t(child->get_int("seed", 0));
+            if (scene.settings.spp < 1) throw child->error("sample_count must be at least 1");
+            loader::warn_unused(*child);
+        } else {
+            throw child->error("unexpected <" + child->tag + "> inside the sensor");
+        }
+    }
+    try {
+        cam.finalize();
+    } catch (const std::exception &e) {
+        throw sensor.error(e.what());
+    }
+    loader::warn_unused(sensor);
+}
+
+}  // namespace
+
+std::unique_ptr<Scene> load_scene(const std::string &path, const std::map<std::string, std::string> &defines) {
+    std::shared_ptr<XmlNode> root = parse_mitsuba_xml(path, defines);
+    auto scene = std::make_unique<Scene>();
+    scene->source_path = path;
+    loader::Factories factories;
+    bool have_sensor = false;
+    for (const auto &node : root->children) {
+        const std::string &tag = node->tag;
+        if (tag == "shape") {
+            factories.shape(*node, *scene);
+        } else if (tag == "emitter") {
+            factories.emitter(*node, *scene);
+        } else if (tag == "sensor") {
+            if (have_sensor) throw node->error("only one sensor is supported");
+            load_sensor(*node, *scene);
+            have_sensor = true;
+        } else if (tag == "integrator") {
+            scene->settings.integrator = node->type;
+            for (auto &[name, prop] : node->props) {
+                std::string v = property_as_string(prop);
+                if (v.empty()) throw node->error("integrator option '" + name + "' must be a number, boolean or string");
+                scene->settings.integrator_options[name] = v;
+                prop.used = true;
+            }
+        } else if (tag == "bsdf" || tag == "texture") {
+            // Declared for later <ref>s; built when a shape uses them.
+        } else {
+            throw node->error("unsupported element <" + tag + "> at the top level of the scene");
+        }
+    }
+    if (!have_sensor) {
+        scene->camera.finalize();  // Mitsuba's default sensor would look from the origin; warn instead of guessing
+        fmt::print(stderr, "neepp: warning: {} has no <sensor>; using a default camera at the origin\n", path);
+    }
+    if (scene->lights().empty())
+        throw SceneError(path, "the scene has no light source (no emitter): the image would be black");
+    try {
+        scene->build();
+    } catch (const std::exception &e) {
+        throw SceneError(path, e.what());
+    }
+    return scene;
+}
+
+}  // namespace neepp

@@ -1,0 +1,169 @@
+#include <cmath>
+#include "neepp/io/obj_reader.h"
+#include "neepp/io/ply_reader.h"
+#include "neepp/lights/area_light.h"
+#include "neepp/lights/environment_light.h"
+#include "neepp/loader/factories.h"
+
+namespace neepp::loader {
+namespace {
+
+// Mitsuba's `rectangle`: [-1,1]^2 in the z = 0 plane, normal +z.
+MeshData rectangle_mesh() {
+    MeshData m;
+    m.positions = {{-1, -1, 0}, {1, -1, 0}, {1, 1, 0}, {-1, 1, 0}};
+    m.normals.assign(4, Vec3(0, 0, 1));
+    m.uvs = {{0, 0}, {1, 0}, {1, 1}, {0, 1}};
+    m.indices = {0, 1, 2, 2, 3, 0};
+    return m;
+}
+
+// Mitsuba's `cube`: [-1,1]^3, four vertices per face so each face has its own outward normal.
+MeshData cube_mesh() {
+    MeshData m;
+    for (int axis = 0; axis < 3; ++axis)
+        for (int sign = -1; sign <= 1; sign += 2) {
+            Vec3 n(0.f);
+            n[axis] = float(sign);
+            int a = (axis + 1) % 3, b = (axis + 2) % 3;
+            uint32_t base = uint32_t(m.positions.size());
+            const float corners[4][2] = {{-1, -1}, {1, -1}, {1, 1}, {-1, 1}};
+            for (auto &c : corners) {
+                Vec3 p = n;
+                p[a] = c[0];
+                p[b] = c[1];
+                m.positions.push_back(p);
+                m.normals.push_back(n);
+                m.uvs.push_back({(c[0] + 1) * 0.5f, (c[1] + 1) * 0.5f});
+            }
+            // Counter-clockwise seen from outside: (a, b, n) is right-handed, so flip for negative faces.
+            if (sign > 0) m.indices.insert(m.indices.end(), {base, base + 1, base + 2, base + 2, base + 3, base});
+            else m.indices.insert(m.indices.end(), {base, base + 2, base + 1, base + 2, base, base + 3});
+        }
+    return m;
+}
+
+// Smooth vertex normals for meshes that have none, weighting each face by its angle at the vertex
+// (Mitsuba's recompute_vertex_normals).
+void compute_vertex_normals(Shape &s) {
+    s.normals.assign(s.positions.size(), Vec3(0.f));
+    for (size_t t = 0; t < s.triangle_count(); ++t) {
+        uint32_t idx[3] = {s.indices[3 * t], s.indices[3 * t + 1], s.indices[3 * t + 2]};
+        Vec3 n = cross(s.positions[idx[1]] - s.positions[idx[0]], s.positions[idx[2]] - s.positions[idx[0]]);
+        float len = norm(n);
+        if (!(len > 0)) continue;
+        n = n / len;
+        for (int k = 0; k < 3; ++k) {
+            Vec3 e1 = s.positions[idx[(k + 1) % 3]] - s.positions[idx[k]];
+            Vec3 e2 = s.positions[idx[(k + 2) % 3]] - s.positions[idx[k]];
+            float l1 = norm(e1), l2 = norm(e2);
+            if (!(l1 > 0 && l2 > 0)) continue;
+            float angle = std::acos(std::clamp(dot(e1, e2) / (l1 * l2), -1.f, 1.f));
+            s.normals[idx[k]] += n * angle;
+        }
+    }
+    for (Vec3 &n : s.normals) {
+        float len = norm(n);
+        n = len > 0 ? n / len : Vec3(0, 0, 1);
+    }
+}
+
+void set_mesh(Shape &s, MeshData mesh, const Transform &to_world) {
+    s.positions.resize(mesh.positions.size());
+    for (size_t i = 0; i < mesh.positions.size(); ++i) s.positions[i] = to_world.point(mesh.positions[i]);
+    s.normals.resize(mesh.normals.size());
+    for (size_t i = 0; i < mesh.normals.size(); ++i) {
+        Vec3 n = to_world.normal(mesh.normals[i]);
+        float len = norm(n);
+        s.normals[i] = len > 0 ? n / len : n;
+    }
+    s.uvs = std::move(mesh.uvs);
+    s.indices = std::move(mesh.indices);
+    for (const Vec3 &p : s.positions)
+        if (!is_finite(p)) throw std::runtime_error("the transformed mesh has non-finite vertices");
+    if (!s.face_normals && s.normals.empty()) compute_vertex_normals(s);
+}
+
+}  // namespace
+
+void Factories::shape(const XmlNode &node, Scene &scene) {
+    auto s = std::make_unique<Shape>();
+    s->id = node.id;
+    s->face_normals = node.get_bool("face_normals", false);
+    s->flip_normals = node.get_bool("flip_normals", false);
+    Transform to_world = node.get_transform("to_world");
+    const std::string &t = node.type;
+    try {
+        if (t == "obj" || t == "ply") {
+            std::string path = node.resolve_path(node.get_string("filename"));
+            set_mesh(*s, t == "obj" ? read_obj(path) : read_ply(path), to_world);
+        } else if (t == "rectangle") {
+            set_mesh(*s, rectangle_mesh(), to_world);
+        } else if (t == "cube") {
+            set_mesh(*s, cube_mesh(), to_world);
+        } else if (t == "sphere") {
+            s->kind = Shape::Kind::Sphere;
+            Vec3 c = node.get_vector("center", Vec3(0.f));
+            float r = node.get_float("radius", 1.f);
+            // A to_world on a sphere may translate and scale uniformly (Mitsuba allows more; we refuse).
+            s->center = to_world.point(c);
+            Vec3 ex = to_world.vector(Vec3(r, 0, 0)), ey = to_world.vector(Vec3(0, r, 0));
+            s->radius = norm(ex);
+            if (std::abs(norm(ey) - s->radius) > 1e-4f * s->radius) throw node.error("sphere to_world must scale uniformly");
+            if (!(s->radius > 0) || !std::isfinite(s->radius) || !is_finite(s->center))
+                throw node.error("sphere needs a positive radius and a finite center");
+        } else {
+            throw node.error("unsupported shape type '" + t + "' (supported: obj, ply, rectangle, cube, sphere)");
+        }
+    } catch (const SceneError &) {
+        throw;
+    } catch (const std::exception &e) {
+        throw node.error(e.what());
+    }
+
+    s->bsdf = default_bsdf();
+    const XmlNode *emitter_node = nullptr;
+    for (const auto &child : node.children) {
+        if (child->tag == "bsdf") s->bsdf = bsdf(*child);
+        else if (child->tag == "emitter") emitter_node = child.get();
+        else throw child->error("unsupported inside a shape: <" + child->tag + ">");
+    }
+    warn_unused(node);
+    Shape *shape = s.get();
+    scene.add_shape(std::move(s));
+    if (emitter_node) {
+        if (emitter_node->type != "area") throw emitter_node->error("a shape can only carry an 'area' emitter");
+        TexturePtr radiance = texture_param(*emitter_node, "radiance", Color(1.f));
+        warn_unused(*emitter_node);
+        shape->area_light = scene.add_light(std::make_unique<AreaLight>(shape, radiance));
+    }
+}
+
+void Factories::emitter(const XmlNode &node, Scene &scene) {
+    const std::string &t = node.type;
+    if (t == "envmap") {
+        std::string path = node.resolve_path(node.get_string("filename"));
+        Image img;
+        try {
+            img = read_image(path);
+        } catch (const std::exception &e) {
+            throw node.error(e.what());
+        }
+        if (img.srgb_encoded)
+            for (float &v : img.data) v = srgb_to_linear(v);
+        float scale = node.get_float("scale", 1.f);
+        scene.add_light(std::make_unique<EnvironmentMapLight>(std::move(img), node.get_transform("to_world"), scale));
+    } else if (t == "constant") {
+        scene.add_light(std::make_unique<ConstantEnvironmentLight>(node.get_rgb("radiance", Color(1.f))));
+    } else if (t == "point") {
+        Vec3 pos = node.get_vector("position", node.get_transform("to_world").point(Vec3(0.f)));
+        scene.add_light(std::make_unique<PointLight>(pos, node.get_rgb("intensity", Color(1.f))));
+    } else if (t == "area") {
+        throw node.error("an 'area' emitter must be nested inside a <shape>");
+    } else {
+        throw node.error("unsupported emitter type '" + t + "' (supported: area, envmap, constant, point)");
+    }
+    warn_unused(node);
+}
+
+}  // namespace neepp::loader

@@ -1,0 +1,59 @@
+#include <fmt/core.h>
+#include "neepp/loader/factories.h"
+#include "neepp/materials/bitmap_texture.h"
+#include "neepp/materials/checkerboard_texture.h"
+
+namespace neepp::loader {
+
+void warn_unused(const XmlNode &node) {
+    for (const std::string &p : node.unused_properties())
+        fmt::print(stderr, "neepp: warning: {}:{}: <{} type=\"{}\"> ignores property '{}'\n", node.file, node.line,
+                   node.tag, node.type, p);
+}
+
+TexturePtr Factories::texture(const XmlNode &node) {
+    if (auto it = textures_.find(&node); it != textures_.end()) return it->second;
+    if (node.tag != "texture") throw node.error("expected a <texture>, found <" + node.tag + ">");
+    TexturePtr tex;
+    if (node.type == "bitmap") {
+        BitmapOptions o;
+        try {
+            o.filter = parse_filter_type(node.get_string("filter_type", "bilinear"));
+            o.wrap = parse_wrap_mode(node.get_string("wrap_mode", "repeat"));
+        } catch (const std::exception &e) {
+            throw node.error(e.what());
+        }
+        o.raw = node.get_bool("raw", false);
+        o.to_uv = node.get_transform("to_uv");
+        std::string path = node.resolve_path(node.get_string("filename"));
+        try {
+            tex = BitmapTexture::load(path, o);
+        } catch (const SceneError &) {
+            throw;
+        } catch (const std::exception &e) {
+            throw node.error(e.what());
+        }
+    } else if (node.type == "checkerboard") {
+        tex = std::make_shared<CheckerboardTexture>(texture_param(node, "color0", Color(0.4f)),
+                                                    texture_param(node, "color1", Color(0.2f)),
+                                                    node.get_transform("to_uv"));
+    } else {
+        throw node.error("unsupported texture type '" + node.type + "' (supported: bitmap, checkerboard)");
+    }
+    warn_unused(node);
+    textures_[&node] = tex;
+    return tex;
+}
+
+TexturePtr Factories::texture_param_or_null(const XmlNode &node, const std::string &name) {
+    if (auto child = node.child(name)) return texture(*child);
+    if (node.has(name)) return constant_texture(node.get_rgb(name));
+    return nullptr;
+}
+
+TexturePtr Factories::texture_param(const XmlNode &node, const std::string &name, Color def) {
+    if (TexturePtr t = texture_param_or_null(node, name)) return t;
+    return constant_texture(def);
+}
+
+}  // namespace neepp::loader

@@ -1,0 +1,155 @@
+#include "neepp/materials/bitmap_texture.h"
+
+#include <array>
+#include <cmath>
+#include <stdexcept>
+
+#include <fmt/format.h>
+
+namespace neepp {
+
+UvTransform::UvTransform(const Transform &t) {
+    const auto &a = t.matrix.m;
+    m[0][0] = a[0][0], m[0][1] = a[0][1], m[0][2] = a[0][3];
+    m[1][0] = a[1][0], m[1][1] = a[1][1], m[1][2] = a[1][3];
+}
+
+Vec2 UvTransform::apply(Vec2 uv) const {
+    return {std::fma(m[0][1], uv.y, std::fma(m[0][0], uv.x, m[0][2])),
+            std::fma(m[1][1], uv.y, std::fma(m[1][0], uv.x, m[1][2]))};
+}
+
+FilterType parse_filter_type(std::string_view s) {
+    if (s == "bilinear") return FilterType::Bilinear;
+    if (s == "nearest") return FilterType::Nearest;
+    throw std::runtime_error(fmt::format("invalid filter_type \"{}\": must be \"bilinear\" or \"nearest\"", s));
+}
+
+WrapMode parse_wrap_mode(std::string_view s) {
+    if (s == "repeat") return WrapMode::Repeat;
+    if (s == "mirror") return WrapMode::Mirror;
+    if (s == "clamp") return WrapMode::Clamp;
+    throw std::runtime_error(fmt::format("invalid wrap_mode \"{}\": must be \"repeat\", \"mirror\" or \"clamp\"", s));
+}
+
+namespace {
+
+// Dr.Jit's integer wrap (texture_impl.h tex_wrap), including its Euclidean modulo and mirror parity rule.
+int wrap(int pos, int res, WrapMode mode) {
+    if (mode == WrapMode::Clamp) return std::clamp(pos, 0, res - 1);
+    const int div = (pos < 0 ? pos + 1 : pos) / res;
+    int mod = pos - div * res;
+    if (mod < 0) mod += res;
+    if (mode == WrapMode::Mirror && !(((div & 1) == 0) ^ (pos < 0))) mod = res - 1 - mod;
+    return mod;
+}
+
+// sRGB decode of a normalized value. 8-bit codes (the common case) hit a table instead of calling pow
+// for every texel of a large texture; the result is identical.
+float decode_srgb(float v) {
+    static const std::array<float, 256> table = [] {
+        std::array<float, 256> t{};
+        for (int i = 0; i < 256; ++i) t[i] = srgb_to_linear(float(i) * (1.f / 255.f));
+        return t;
+    }();
+    const float code = std::round(v * 255.f);
+    if (code >= 0.f && code <= 255.f && float(code) * (1.f / 255.f) == v) return table[int(code)];
+    return srgb_to_linear(v);
+}
+
+}  // namespace
+
+struct BitmapTexture::Lookup {
+    int x0, x1, y0, y1;     // wrapped texel coordinates of the 2x2 footprint
+    float wx0, wx1, wy0, wy1;  // bilinear weights toward the lower / upper texel
+};
+
+BitmapTexture::BitmapTexture(const Image &image, const BitmapOptions &options)
+    : width_(image.width), height_(image.height), channels_(image.color_channels()), options_(options),
+      to_uv_(options.to_uv) {
+    if (width_ <= 0 || height_ <= 0 || image.data.size() != size_t(width_) * height_ * image.channels)
+        throw std::runtime_error(fmt::format("bitmap texture: invalid image ({}x{}, {} channels)", width_,
+                                             height_, image.channels));
+    const bool linearize = image.srgb_encoded && !options.raw;
+    const size_t pixels = size_t(width_) * height_;
+    texels_.resize(pixels * channels_);
+    double sum = 0, sum_rgb[3] = {0, 0, 0};
+    for (size_t i = 0; i < pixels; ++i) {
+        float *t = &texels_[i * channels_];
+        for (int c = 0; c < channels_; ++c) {  // alpha (the last source channel) is dropped, as in Mitsuba
+            float v = image.data[i * image.channels + c];
+            t[c] = linearize ? decode_srgb(v) : v;
+            sum_rgb[c] += t[c];
+        }
+        sum += channels_ == 1 ? t[0] : luminance(Color(t[0], t[1], t[2]));
+    }
+    mean_ = float(sum / double(pixels));
+    mean_rgb_ = channels_ == 1 ? Color(mean_)
+                               : Color(float(sum_rgb[0] / pixels), float(sum_rgb[1] / pixels),
+                                       float(sum_rgb[2] / pixels));
+}
+
+std::shared_ptr<BitmapTexture> BitmapTexture::load(const std::string &filename, const BitmapOptions &options) {
+    return std::make_shared<BitmapTexture>(read_image(filename), options);
+}
+
+Color BitmapTexture::texel(int x, int y) const {
+    const float *t = &texels_[(size_t(y) * width_ + x) * channels_];
+    return channels_ == 1 ? Color(t[0]) : Color(t[0], t[1], t[2]);
+}
+
+// Dr.Jit's linear lookup: texel centers at (i + 0.5) / res, so the footprint starts at floor(u*res - 0.5).
+BitmapTexture::Lookup BitmapTexture::locate(Vec2 uv) const {
+    const float px = std::fma(uv.x, float(width_), -0.5f), py = std::fma(uv.y, float(height_), -0.5f);
+    const float fx = std::floor(px), fy = std::floor(py);
+    const int ix = int(fx), iy = int(fy);
+    Lookup l;
+    l.wx1 = px - fx, l.wx0 = 1.f - l.wx1;
+    l.wy1 = py - fy, l.wy0 = 1.f - l.wy1;
+    l.x0 = wrap(ix, width_, options_.wrap), l.x1 = wrap(ix + 1, width_, options_.wrap);
+    l.y0 = wrap(iy, height_, options_.wrap), l.y1 = wrap(iy + 1, height_, options_.wrap);
+    return l;
+}
+
+Color BitmapTexture::interpolate(Vec2 uv) const {
+    if (options_.filter == FilterType::Nearest) {
+        // Nearest: no half-texel shift, the texel containing u*res.
+        const int x = int(std::floor(uv.x * float(width_))), y = int(std::floor(uv.y * float(height_)));
+        return texel(wrap(x, width_, options_.wrap), wrap(y, height_, options_.wrap));
+    }
+    const Lookup l = locate(uv);
+    // Same corner order and fused accumulation as Dr.Jit, so results agree to the last bit.
+    const Color c[4] = {texel(l.x0, l.y0), texel(l.x1, l.y0), texel(l.x0, l.y1), texel(l.x1, l.y1)};
+    const float w[4] = {l.wx0 * l.wy0, l.wx1 * l.wy0, l.wx0 * l.wy1, l.wx1 * l.wy1};
+    Color out(0.f);
+    for (int k = 0; k < 4; ++k)
+        for (int ch = 0; ch < 3; ++ch) out[ch] = std::fma(c[k][ch], w[k], out[ch]);
+    return out;
+}
+
+Color BitmapTexture::eval(const SurfaceInteraction &si) const { return interpolate(to_uv_.apply(si.uv)); }
+
+float BitmapTexture::eval_1(const SurfaceInteraction &si) const {
+    const Color c = interpolate(to_uv_.apply(si.uv));
+    return channels_ == 1 ? c.x : luminance(c);
+}
+
+Vec2 BitmapTexture::eval_1_grad(const SurfaceInteraction &si) const {
+    if (options_.filter == FilterType::Nearest) return {0.f, 0.f};  // piecewise constant
+    const Lookup l = locate(to_uv_.apply(si.uv));
+    auto value = [&](int x, int y) {
+        const Color c = texel(x, y);
+        return channels_ == 1 ? c.x : luminance(c);
+    };
+    const float f00 = value(l.x0, l.y0), f10 = value(l.x1, l.y0), f01 = value(l.x0, l.y1),
+                f11 = value(l.x1, l.y1);
+    // Partials w.r.t. texel coordinates, then chain rule through to_uv (transpose multiply).
+    const float dx = std::fma(l.wy0, f10 - f00, l.wy1 * (f11 - f01));
+    const float dy = std::fma(l.wx0, f01 - f00, l.wx1 * (f11 - f10));
+    const auto &m = to_uv_.m;
+    const float du = m[0][0] * dx + m[1][0] * dy, dv = m[0][1] * dx + m[1][1] * dy;
+    // Mitsuba scales by the resolution after the transpose multiply (exact for diagonal to_uv).
+    return {float(width_) * du, float(height_) * dv};
+}
+
+}  // namespace neepp

@@ -1,0 +1,68 @@
+// The BSDF interface. Directions are in the local shading frame (z = shading normal).
+//
+// Conventions (Mitsuba 3's): `wi` points toward the previous path vertex (toward the camera when tracing
+// radiance), `wo` toward the next one. eval() returns f(wi, wo) * |cos(theta_o)|. The TransportMode tells
+// whether radiance (camera paths) or importance (light paths, for BDPT and light tracing) is carried: it
+// matters for refraction (the eta^2 radiance scaling) and for shading-normal corrections. pdf(wi, wo) is
+// the solid-angle density of sampling wo given wi; the reverse density, needed by BDPT's MIS, is pdf with
+// the arguments swapped and the mode flipped.
+#pragma once
+#include <cstdint>
+#include <memory>
+#include "neepp/materials/texture.h"
+#include "neepp/scene/interaction.h"
+
+namespace neepp {
+
+enum class TransportMode { Radiance, Importance };
+
+inline TransportMode flip(TransportMode m) {
+    return m == TransportMode::Radiance ? TransportMode::Importance : TransportMode::Radiance;
+}
+
+// Lobe flags, as Mitsuba's BSDFFlags.
+enum BSDFFlags : uint32_t {
+    BSDFNone = 0,
+    BSDFNull = 1u << 0,                 // passes light straight through (mask)
+    BSDFDiffuseReflection = 1u << 1,
+    BSDFDiffuseTransmission = 1u << 2,
+    BSDFGlossyReflection = 1u << 3,
+    BSDFGlossyTransmission = 1u << 4,
+    BSDFDeltaReflection = 1u << 5,
+    BSDFDeltaTransmission = 1u << 6,
+    BSDFDiffuse = BSDFDiffuseReflection | BSDFDiffuseTransmission,
+    BSDFGlossy = BSDFGlossyReflection | BSDFGlossyTransmission,
+    BSDFSmooth = BSDFDiffuse | BSDFGlossy,  // lobes that next event estimation can evaluate
+    BSDFDelta = BSDFNull | BSDFDeltaReflection | BSDFDeltaTransmission,
+    BSDFReflection = BSDFDiffuseReflection | BSDFGlossyReflection | BSDFDeltaReflection,
+    BSDFTransmission = BSDFNull | BSDFDiffuseTransmission | BSDFGlossyTransmission | BSDFDeltaTransmission,
+};
+
+struct BSDFContext {
+    TransportMode mode = TransportMode::Radiance;
+};
+
+struct BSDFSample {
+    Vec3 wo;                  // sampled direction (local)
+    float pdf = 0;            // solid-angle density (1 for a chosen delta lobe, times its selection probability)
+    float eta = 1;            // relative index of refraction along the sampled direction (1 for reflection)
+    uint32_t sampled_flags = BSDFNone;
+    Color weight;             // f * |cos(theta_o)| / pdf (the delta case folded in); zero if sampling failed
+    bool valid() const { return pdf > 0 && !is_black(weight); }
+};
+
+class BSDF {
+public:
+    virtual ~BSDF() = default;
+    virtual Color eval(const BSDFContext &ctx, const SurfaceInteraction &si, const Vec3 &wi, const Vec3 &wo) const = 0;
+    virtual float pdf(const BSDFContext &ctx, const SurfaceInteraction &si, const Vec3 &wi, const Vec3 &wo) const = 0;
+    // u1 chooses a lobe, u2 the direction within it.
+    virtual BSDFSample sample(const BSDFContext &ctx, const SurfaceInteraction &si, const Vec3 &wi, float u1,
+                              Vec2 u2) const = 0;
+    virtual uint32_t flags() const = 0;
+    bool has_flag(uint32_t f) const { return (flags() & f) != 0; }
+};
+
+using BSDFPtr = std::shared_ptr<const BSDF>;
+
+}  // namespace neepp

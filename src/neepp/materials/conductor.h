@@ -1,0 +1,32 @@
+// Smooth conductor (Mitsuba's `conductor`): a one-sided perfect mirror with complex-IOR Fresnel.
+//
+// Mitsuba XML parameters (default):
+//   material              string  "none"  named preset (lookup_conductor_ior); "none" = 100% reflecting mirror.
+//                                         Giving both `material` (other than "none") and `eta` is an error.
+//   eta                   texture 0.0     real part of the IOR (used when `eta` is given or material is "none")
+//   k                     texture 1.0     imaginary part (absorption)
+//   specular_reflectance  texture 1.0     multiplier (not physical)
+#pragma once
+#include "neepp/materials/bsdf.h"
+
+namespace neepp {
+
+class ConductorBSDF final : public BSDF {
+public:
+    // A null specular_reflectance means 1.
+    ConductorBSDF(TexturePtr eta, TexturePtr k, TexturePtr specular_reflectance = nullptr);
+    Color eval(const BSDFContext &, const SurfaceInteraction &, const Vec3 &, const Vec3 &) const override {
+        return Color(0.f);
+    }
+    float pdf(const BSDFContext &, const SurfaceInteraction &, const Vec3 &, const Vec3 &) const override {
+        return 0.f;
+    }
+    BSDFSample sample(const BSDFContext &ctx, const SurfaceInteraction &si, const Vec3 &wi, float u1,
+                      Vec2 u2) const override;
+    uint32_t flags() const override { return BSDFDeltaReflection; }
+
+private:
+    TexturePtr eta_, k_, specular_reflectance_;
+};
+
+}  // namespace neepp

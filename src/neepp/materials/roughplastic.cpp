@@ -1,0 +1,85 @@
+#include "neepp/materials/roughplastic.h"
+
+#include "neepp/materials/fresnel.h"
+#include "neepp/materials/plastic.h"
+#include "neepp/math/warp.h"
+
+namespace neepp {
+
+RoughPlasticBSDF::RoughPlasticBSDF(MicrofacetType type, float alpha, float int_ior, float ext_ior,
+                                   TexturePtr diffuse_reflectance, TexturePtr specular_reflectance, bool nonlinear,
+                                   bool sample_visible)
+    : distr_(type, alpha, sample_visible), eta_(int_ior / ext_ior), inv_eta_2_(1.f / (eta_ * eta_)),
+      diffuse_reflectance_(std::move(diffuse_reflectance)),
+      specular_reflectance_(specular_reflectance ? std::move(specular_reflectance) : constant_texture(1.f)),
+      nonlinear_(nonlinear),
+      specular_sampling_weight_(specular_sampling_weight(*diffuse_reflectance_, *specular_reflectance_)) {
+    // Mitsuba tabulates with visible-normal quadrature whatever sample_visible says.
+    MicrofacetDistribution visible(type, alpha, true);
+    float reflectance_sum = 0.f;
+    for (int i = 0; i < kTransmittanceRes; ++i) {
+        float mu = std::max(1e-6f, float(i) / float(kTransmittanceRes - 1));
+        Vec3 wi(std::sqrt(1.f - mu * mu), 0.f, mu);
+        external_transmittance_[i] = eval_transmittance(visible, wi, eta_);
+        reflectance_sum += eval_reflectance(visible, wi, 1.f / eta_) * mu;
+    }
+    // Cosine-weighted hemispherical average: 2 * mean over mu of R(mu) mu.
+    internal_reflectance_ = reflectance_sum / float(kTransmittanceRes) * 2.f;
+}
+
+float RoughPlasticBSDF::external_transmittance(float cos_theta) const {
+    float x = cos_theta * float(kTransmittanceRes - 1);
+    int index = std::min(int(x), kTransmittanceRes - 2);
+    float t = x - float(index);
+    return external_transmittance_[index] * (1.f - t) + external_transmittance_[index + 1] * t;
+}
+
+float RoughPlasticBSDF::prob_specular(float cos_theta_i) const {
+    float t_i = external_transmittance(cos_theta_i);
+    float p_s = (1.f - t_i) * specular_sampling_weight_, p_d = t_i * (1.f - specular_sampling_weight_);
+    return p_s / (p_s + p_d);
+}
+
+Color RoughPlasticBSDF::eval(const BSDFContext &, const SurfaceInteraction &si, const Vec3 &wi,
+                             const Vec3 &wo) const {
+    if (wi.z <= 0.f || wo.z <= 0.f) return Color(0.f);
+    Vec3 h = normalize(wo + wi);
+    float f = fresnel_dielectric(dot(wi, h), eta_).r;
+    Color value = specular_reflectance_->eval(si) * (f * distr_.eval(h) * distr_.G(wi, wo, h) / (4.f * wi.z));
+
+    // Diffuse base seen through the coating's transmittance both ways; the internal reflectance is
+    // summed as a geometric series (per channel when nonlinear).
+    Color diff = diffuse_reflectance_->eval(si);
+    diff = diff / (nonlinear_ ? Color(1.f) - diff * internal_reflectance_ : Color(1.f - internal_reflectance_));
+    float t_i = external_transmittance(wi.z), t_o = external_transmittance(wo.z);
+    return value + diff * (kInvPi * inv_eta_2_ * wo.z * t_i * t_o);
+}
+
+float RoughPlasticBSDF::pdf(const BSDFContext &, const SurfaceInteraction &, const Vec3 &wi, const Vec3 &wo) const {
+    if (wi.z <= 0.f || wo.z <= 0.f) return 0.f;
+    float p_spec = prob_specular(wi.z);
+    Vec3 h = normalize(wo + wi);
+    float spec = distr_.sample_visible() ? distr_.eval(h) * distr_.smith_g1(wi, h) / (4.f * wi.z)
+                                         : distr_.pdf(wi, h) / (4.f * dot(wo, h));
+    return p_spec * spec + (1.f - p_spec) * square_to_cosine_hemisphere_pdf(wo);
+}
+
+BSDFSample RoughPlasticBSDF::sample(const BSDFContext &ctx, const SurfaceInteraction &si, const Vec3 &wi, float u1,
+                                    Vec2 u2) const {
+    BSDFSample bs;
+    if (wi.z <= 0.f) return bs;
+    if (u1 < prob_specular(wi.z)) {
+        bs.wo = reflect(wi, distr_.sample(wi, u2).first);
+        bs.sampled_flags = BSDFGlossyReflection;
+    } else {
+        bs.wo = square_to_cosine_hemisphere(u2);
+        bs.sampled_flags = BSDFDiffuseReflection;
+    }
+    // Both lobes can produce either direction, so the weight uses the full mixture density.
+    bs.pdf = pdf(ctx, si, wi, bs.wo);
+    if (!(bs.pdf > 0.f)) return BSDFSample{};
+    bs.weight = eval(ctx, si, wi, bs.wo) / bs.pdf;
+    return bs;
+}
+
+}  // namespace neepp

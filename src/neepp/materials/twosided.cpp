@@ -1,0 +1,96 @@
+#include "neepp/materials/twosided.h"
+
+namespace neepp {
+namespace {
+Vec3 flip_z(Vec3 v) { return {v.x, v.y, -v.z}; }
+}  // namespace
+
+Color TwoSidedBSDF::eval(const BSDFContext &ctx, const SurfaceInteraction &si, const Vec3 &wi, const Vec3 &wo) const {
+    return wi.z >= 0 ? front_->eval(ctx, si, wi, wo) : back_->eval(ctx, si, flip_z(wi), flip_z(wo));
+}
+
+float TwoSidedBSDF::pdf(const BSDFContext &ctx, const SurfaceInteraction &si, const Vec3 &wi, const Vec3 &wo) const {
+    return wi.z >= 0 ? front_->pdf(ctx, si, wi, wo) : back_->pdf(ctx, si, flip_z(wi), flip_z(wo));
+}
+
+BSDFSample TwoSidedBSDF::sample(const BSDFContext &ctx, const SurfaceInteraction &si, const Vec3 &wi, float u1,
+                                Vec2 u2) const {
+    if (wi.z >= 0) return front_->sample(ctx, si, wi, u1, u2);
+    BSDFSample bs = back_->sample(ctx, si, flip_z(wi), u1, u2);
+    bs.wo = flip_z(bs.wo);
+    return bs;
+}
+
+Color MaskBSDF::eval(const BSDFContext &ctx, const SurfaceInteraction &si, const Vec3 &wi, const Vec3 &wo) const {
+    return nested_->eval(ctx, si, wi, wo) * opacity(si);
+}
+
+float MaskBSDF::pdf(const BSDFContext &ctx, const SurfaceInteraction &si, const Vec3 &wi, const Vec3 &wo) const {
+    return nested_->pdf(ctx, si, wi, wo) * opacity(si);
+}
+
+BSDFSample MaskBSDF::sample(const BSDFContext &ctx, const SurfaceInteraction &si, const Vec3 &wi, float u1,
+                            Vec2 u2) const {
+    float a = opacity(si);
+    if (u1 >= a) {  // pass through: a null event chosen with probability 1 - a, weight (1-a)/(1-a)
+        BSDFSample bs;
+        bs.wo = -wi;
+        bs.pdf = 1.f - a;
+        bs.sampled_flags = BSDFNull;
+        bs.weight = Color(1.f);
+        return bs;
+    }
+    BSDFSample bs = nested_->sample(ctx, si, wi, u1 / a, u2);
+    bs.pdf *= a;  // f is scaled by a too, so the weight f/pdf is unchanged
+    return bs;
+}
+
+Frame BumpMapBSDF::perturbed_frame(const SurfaceInteraction &si) const {
+    Vec2 g = height_->eval_1_grad(si);
+    g = g * scale_;
+    const Vec3 &n = si.sh_frame.n;
+    Vec3 dpdu = si.dpdu + n * (g.x - dot(n, si.dpdu));
+    Vec3 dpdv = si.dpdv + n * (g.y - dot(n, si.dpdv));
+    Vec3 pn = cross(dpdu, dpdv);
+    float len2 = squared_norm(pn);
+    if (!(len2 > 0) || !std::isfinite(len2)) return si.sh_frame;
+    pn = pn / std::sqrt(len2);
+    if (dot(si.n, pn) < 0) pn = -pn;
+    Vec3 s = dpdu - pn * dot(pn, dpdu);
+    float s2 = squared_norm(s);
+    if (!(s2 > 0)) return Frame(pn);
+    s = s / std::sqrt(s2);
+    return Frame(s, cross(pn, s), pn);
+}
+
+SurfaceInteraction BumpMapBSDF::perturbed(const SurfaceInteraction &si, const Vec3 &wi, Vec3 &wi_p) const {
+    SurfaceInteraction p = si;
+    p.sh_frame = perturbed_frame(si);
+    wi_p = p.to_local(si.to_world(wi));
+    p.wi = wi_p;
+    return p;
+}
+
+Color BumpMapBSDF::eval(const BSDFContext &ctx, const SurfaceInteraction &si, const Vec3 &wi, const Vec3 &wo) const {
+    Vec3 wi_p;
+    SurfaceInteraction p = perturbed(si, wi, wi_p);
+    Vec3 wo_p = p.to_local(si.to_world(wo));
+    return nested_->eval(ctx, p, wi_p, wo_p);
+}
+
+float BumpMapBSDF::pdf(const BSDFContext &ctx, const SurfaceInteraction &si, const Vec3 &wi, const Vec3 &wo) const {
+    Vec3 wi_p;
+    SurfaceInteraction p = perturbed(si, wi, wi_p);
+    return nested_->pdf(ctx, p, wi_p, p.to_local(si.to_world(wo)));
+}
+
+BSDFSample BumpMapBSDF::sample(const BSDFContext &ctx, const SurfaceInteraction &si, const Vec3 &wi, float u1,
+                               Vec2 u2) const {
+    Vec3 wi_p;
+    SurfaceInteraction p = perturbed(si, wi, wi_p);
+    BSDFSample bs = nested_->sample(ctx, p, wi_p, u1, u2);
+    bs.wo = si.to_local(p.to_world(bs.wo));
+    return bs;
+}
+
+}  // namespace neepp

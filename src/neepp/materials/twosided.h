@@ -1,0 +1,60 @@
+// Mitsuba's `twosided`: makes a one-sided BSDF (or a pair, front and back) reflect on both sides by
+// mirroring directions seen from below into the upper hemisphere.
+#pragma once
+#include "neepp/materials/bsdf.h"
+
+namespace neepp {
+
+class TwoSidedBSDF final : public BSDF {
+public:
+    TwoSidedBSDF(BSDFPtr front, BSDFPtr back) : front_(std::move(front)), back_(back ? std::move(back) : front_) {}
+    Color eval(const BSDFContext &ctx, const SurfaceInteraction &si, const Vec3 &wi, const Vec3 &wo) const override;
+    float pdf(const BSDFContext &ctx, const SurfaceInteraction &si, const Vec3 &wi, const Vec3 &wo) const override;
+    BSDFSample sample(const BSDFContext &ctx, const SurfaceInteraction &si, const Vec3 &wi, float u1,
+                      Vec2 u2) const override;
+    uint32_t flags() const override { return front_->flags() | back_->flags(); }
+
+private:
+    BSDFPtr front_, back_;
+};
+
+// Mitsuba's `mask`: an opacity texture; with probability 1 - opacity light passes straight through
+// (a null, delta-transmission event), otherwise the nested BSDF scatters it.
+class MaskBSDF final : public BSDF {
+public:
+    MaskBSDF(TexturePtr opacity, BSDFPtr nested) : opacity_(std::move(opacity)), nested_(std::move(nested)) {}
+    Color eval(const BSDFContext &ctx, const SurfaceInteraction &si, const Vec3 &wi, const Vec3 &wo) const override;
+    float pdf(const BSDFContext &ctx, const SurfaceInteraction &si, const Vec3 &wi, const Vec3 &wo) const override;
+    BSDFSample sample(const BSDFContext &ctx, const SurfaceInteraction &si, const Vec3 &wi, float u1,
+                      Vec2 u2) const override;
+    uint32_t flags() const override { return nested_->flags() | BSDFNull; }
+
+private:
+    float opacity(const SurfaceInteraction &si) const { return std::clamp(opacity_->eval_1(si), 0.f, 1.f); }
+    TexturePtr opacity_;
+    BSDFPtr nested_;
+};
+
+// Mitsuba's `bumpmap`: perturbs the shading frame by the gradient of a height texture (times `scale`)
+// and evaluates the nested BSDF in the perturbed frame.
+class BumpMapBSDF final : public BSDF {
+public:
+    BumpMapBSDF(TexturePtr height, float scale, BSDFPtr nested)
+        : height_(std::move(height)), scale_(scale), nested_(std::move(nested)) {}
+    Color eval(const BSDFContext &ctx, const SurfaceInteraction &si, const Vec3 &wi, const Vec3 &wo) const override;
+    float pdf(const BSDFContext &ctx, const SurfaceInteraction &si, const Vec3 &wi, const Vec3 &wo) const override;
+    BSDFSample sample(const BSDFContext &ctx, const SurfaceInteraction &si, const Vec3 &wi, float u1,
+                      Vec2 u2) const override;
+    uint32_t flags() const override { return nested_->flags(); }
+    // The perturbed shading frame, in world space.
+    Frame perturbed_frame(const SurfaceInteraction &si) const;
+
+private:
+    // Copy of si with the perturbed frame, and a map from si's local directions into it.
+    SurfaceInteraction perturbed(const SurfaceInteraction &si, const Vec3 &wi, Vec3 &wi_p) const;
+    TexturePtr height_;
+    float scale_;
+    BSDFPtr nested_;
+};
+
+}  // namespace neepp

@@ -1,0 +1,81 @@
+#include "neepp/math/distribution.h"
+
+#include <algorithm>
+#include <stdexcept>
+
+namespace neepp {
+
+Distribution1D::Distribution1D(std::vector<float> weights) : weights_(std::move(weights)) {
+    cdf_.resize(weights_.size() + 1);
+    double sum = 0;
+    cdf_[0] = 0;
+    for (size_t i = 0; i < weights_.size(); ++i) {
+        if (!(weights_[i] >= 0) || !std::isfinite(weights_[i])) weights_[i] = 0;  // NaN/inf/negative → 0
+        sum += weights_[i];
+        cdf_[i + 1] = sum;
+    }
+    total_ = float(sum);
+    if (sum > 0)
+        for (auto &c : cdf_) c /= sum;
+}
+
+uint32_t Distribution1D::sample_discrete(float u, float *pmf_out) const {
+    // First index whose cdf_[i+1] > u; skips zero-weight entries because their cdf does not increase.
+    auto it = std::upper_bound(cdf_.begin() + 1, cdf_.end(), double(u));
+    uint32_t i = uint32_t(std::min<ptrdiff_t>(it - cdf_.begin() - 1, ptrdiff_t(weights_.size()) - 1));
+    while (i > 0 && weights_[i] == 0) --i;  // u at the top edge
+    if (pmf_out) *pmf_out = pmf(i);
+    return i;
+}
+
+uint32_t Distribution1D::sample_reuse(float &u, float *pmf_out) const {
+    uint32_t i = sample_discrete(u, pmf_out);
+    double lo = cdf_[i], w = cdf_[i + 1] - cdf_[i];
+    u = w > 0 ? float(std::clamp((u - lo) / w, 0.0, 0.99999994)) : 0.f;
+    return i;
+}
+
+float Distribution1D::sample_continuous(float u, float *pdf_out, uint32_t *index) const {
+    float ru = u;
+    uint32_t i = sample_reuse(ru, nullptr);
+    if (index) *index = i;
+    size_t n = weights_.size();
+    if (pdf_out) *pdf_out = total_ > 0 ? weights_[i] * float(n) / total_ : 0.f;
+    return std::min((float(i) + ru) / float(n), 0.99999994f);
+}
+
+float Distribution1D::pdf_continuous(float x) const {
+    size_t n = weights_.size();
+    size_t i = std::min(size_t(std::max(0.f, x) * float(n)), n - 1);
+    return total_ > 0 ? weights_[i] * float(n) / total_ : 0.f;
+}
+
+Distribution2D::Distribution2D(const std::vector<float> &weights, int width, int height)
+    : width_(width), height_(height) {
+    if (width <= 0 || height <= 0 || weights.size() != size_t(width) * size_t(height))
+        throw std::invalid_argument("Distribution2D: bad dimensions");
+    std::vector<float> row_sums(height);
+    conditional_.reserve(height);
+    for (int y = 0; y < height; ++y) {
+        std::vector<float> row(weights.begin() + size_t(y) * width, weights.begin() + size_t(y + 1) * width);
+        conditional_.emplace_back(std::move(row));
+        row_sums[y] = conditional_.back().total();
+    }
+    marginal_ = Distribution1D(std::move(row_sums));
+}
+
+Vec2 Distribution2D::sample(Vec2 u, float *pdf_out) const {
+    float pdf_y, pdf_x;
+    uint32_t row;
+    float y = marginal_.sample_continuous(u.y, &pdf_y, &row);
+    float x = conditional_[row].sample_continuous(u.x, &pdf_x);
+    if (pdf_out) *pdf_out = pdf_x * pdf_y;
+    return {x, y};
+}
+
+float Distribution2D::pdf(Vec2 p) const {
+    int row = std::clamp(int(p.y * float(height_)), 0, height_ - 1);
+    return marginal_.pdf_continuous(p.y) * conditional_[row].pdf_continuous(p.x);
+}
+
+}  // namespace neepp

@@ -1,0 +1,47 @@
+// Piecewise-constant distributions: discrete (for choosing lights or triangles) and 2D (for environment maps).
+#pragma once
+#include <cstdint>
+#include <vector>
+#include "neepp/math/vec.h"
+
+namespace neepp {
+
+class Distribution1D {
+public:
+    Distribution1D() = default;
+    explicit Distribution1D(std::vector<float> weights);
+    size_t size() const { return weights_.size(); }
+    bool empty() const { return weights_.empty(); }
+    float total() const { return total_; }
+    // Discrete sampling: returns an index with probability weight[i] / total.
+    uint32_t sample_discrete(float u, float *pmf = nullptr) const;
+    // Same, and rescales u to a fresh uniform variate in [0,1) for reuse.
+    uint32_t sample_reuse(float &u, float *pmf = nullptr) const;
+    float pmf(uint32_t i) const { return total_ > 0 ? weights_[i] / total_ : 0.f; }
+    // Continuous sampling over [0,1) with a piecewise-constant density; returns the position and its pdf.
+    float sample_continuous(float u, float *pdf, uint32_t *index = nullptr) const;
+    float pdf_continuous(float x) const;
+
+private:
+    std::vector<float> weights_;
+    std::vector<double> cdf_;  // cdf_[i] = sum of weights before i, normalized; size n+1
+    float total_ = 0;
+};
+
+// Piecewise-constant 2D distribution over [0,1)^2 from a row-major grid of weights (rows = y).
+class Distribution2D {
+public:
+    Distribution2D() = default;
+    Distribution2D(const std::vector<float> &weights, int width, int height);
+    Vec2 sample(Vec2 u, float *pdf) const;
+    float pdf(Vec2 p) const;
+    int width() const { return width_; }
+    int height() const { return height_; }
+
+private:
+    std::vector<Distribution1D> conditional_;  // one per row
+    Distribution1D marginal_;
+    int width_ = 0, height_ = 0;
+};
+
+}  // namespace neepp

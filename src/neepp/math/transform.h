@@ -1,0 +1,39 @@
+// 4x4 affine/projective transforms (row-major), as used by Mitsuba's <transform> element.
+#pragma once
+#include <array>
+#include "neepp/math/vec.h"
+
+namespace neepp {
+
+struct Matrix4 {
+    std::array<std::array<float, 4>, 4> m{};
+    static Matrix4 identity();
+    Matrix4 operator*(const Matrix4 &o) const;
+    Matrix4 inverse() const;  // general inverse; throws std::runtime_error on a singular matrix
+    Matrix4 transpose() const;
+};
+
+struct Transform {
+    Matrix4 matrix = Matrix4::identity(), inverse_matrix = Matrix4::identity();
+    Transform() = default;
+    explicit Transform(const Matrix4 &m) : matrix(m), inverse_matrix(m.inverse()) {}
+    Transform(const Matrix4 &m, const Matrix4 &inv) : matrix(m), inverse_matrix(inv) {}
+
+    static Transform translate(const Vec3 &d);
+    static Transform scale(const Vec3 &s);
+    static Transform rotate(const Vec3 &axis, float degrees);
+    // Mitsuba's lookat: camera at origin looking down +z becomes camera at `origin` looking at `target`.
+    static Transform look_at(const Vec3 &origin, const Vec3 &target, const Vec3 &up);
+
+    Transform operator*(const Transform &o) const { return {matrix * o.matrix, o.inverse_matrix * inverse_matrix}; }
+    Transform inverse() const { return {inverse_matrix, matrix}; }
+
+    Vec3 point(const Vec3 &p) const;
+    Vec3 vector(const Vec3 &v) const;
+    // Normals transform by the inverse transpose.
+    Vec3 normal(const Vec3 &n) const;
+    // Whether the transform flips orientation (negative determinant of the linear part).
+    bool flips_handedness() const;
+};
+
+}  // namespace neepp

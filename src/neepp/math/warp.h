@@ -1,0 +1,54 @@
+// Warps from the unit square to common domains, with their densities.
+#pragma once
+#include "neepp/math/vec.h"
+
+namespace neepp {
+
+inline Vec2 square_to_uniform_disk_concentric(Vec2 u) {
+    float a = 2.f * u.x - 1.f, b = 2.f * u.y - 1.f;
+    if (a == 0 && b == 0) return {0, 0};
+    float r, phi;
+    if (std::abs(a) > std::abs(b)) { r = a; phi = (kPi / 4.f) * (b / a); }
+    else { r = b; phi = (kPi / 2.f) - (kPi / 4.f) * (a / b); }
+    return {r * std::cos(phi), r * std::sin(phi)};
+}
+
+inline Vec3 square_to_cosine_hemisphere(Vec2 u) {
+    Vec2 d = square_to_uniform_disk_concentric(u);
+    float z = safe_sqrt(1.f - d.x * d.x - d.y * d.y);
+    return {d.x, d.y, z};
+}
+inline float square_to_cosine_hemisphere_pdf(const Vec3 &v) { return v.z > 0 ? v.z * kInvPi : 0.f; }
+
+inline Vec3 square_to_uniform_sphere(Vec2 u) {
+    float z = 1.f - 2.f * u.y, r = safe_sqrt(1.f - z * z), phi = 2.f * kPi * u.x;
+    return {r * std::cos(phi), r * std::sin(phi), z};
+}
+inline float square_to_uniform_sphere_pdf() { return kInv4Pi; }
+
+inline Vec3 square_to_uniform_hemisphere(Vec2 u) {
+    float z = u.y, r = safe_sqrt(1.f - z * z), phi = 2.f * kPi * u.x;
+    return {r * std::cos(phi), r * std::sin(phi), z};
+}
+inline float square_to_uniform_hemisphere_pdf() { return kInv2Pi; }
+
+// Uniform direction within a cone of half-angle acos(cos_max) around +z.
+inline Vec3 square_to_uniform_cone(Vec2 u, float cos_max) {
+    float cos_t = (1.f - u.y) + u.y * cos_max, sin_t = safe_sqrt(1.f - cos_t * cos_t), phi = 2.f * kPi * u.x;
+    return {sin_t * std::cos(phi), sin_t * std::sin(phi), cos_t};
+}
+inline float square_to_uniform_cone_pdf(float cos_max) { return 1.f / (2.f * kPi * (1.f - cos_max)); }
+
+// Barycentric coordinates (b1, b2) of a uniformly distributed point on a triangle.
+inline Vec2 square_to_uniform_triangle(Vec2 u) {
+    float t = safe_sqrt(1.f - u.x);
+    return {1.f - t, t * u.y};
+}
+
+// Power heuristic with beta = 2 (Veach), as in Mitsuba's path integrator.
+inline float mis_power(float pdf_a, float pdf_b) {
+    float a = pdf_a * pdf_a, b = pdf_b * pdf_b;
+    return a > 0 ? a / (a + b) : 0.f;
+}
+
+}  // namespace neepp

@@ -1,0 +1,76 @@
+#include "neepp/render/film.h"
+
+#include <cmath>
+#include <stdexcept>
+
+namespace neepp {
+
+ReconstructionFilter::ReconstructionFilter(const std::string &type, float radius, float stddev)
+    : radius_(radius), stddev_(stddev) {
+    if (type == "box") type_ = Type::Box;
+    else if (type == "tent") type_ = Type::Tent;
+    else if (type == "gaussian") type_ = Type::Gaussian;
+    else throw std::invalid_argument("unknown reconstruction filter '" + type + "' (box, tent, gaussian)");
+    if (!(radius > 0) || radius > 16) throw std::invalid_argument("filter radius must be in (0, 16]");
+    // Mitsuba's gaussian is shifted so it reaches zero at the radius.
+    if (type_ == Type::Gaussian) gauss_offset_ = std::exp(-0.5f * radius_ * radius_ / (stddev_ * stddev_));
+}
+
+float ReconstructionFilter::eval(float x) const {
+    x = std::abs(x);
+    switch (type_) {
+    case Type::Box: return x <= radius_ ? 1.f : 0.f;
+    case Type::Tent: return std::max(0.f, 1.f - x / radius_);
+    case Type::Gaussian: return std::max(0.f, std::exp(-0.5f * x * x / (stddev_ * stddev_)) - gauss_offset_);
+    }
+    return 0.f;
+}
+
+ImageBlock::ImageBlock(int x0, int y0, int width, int height, const ReconstructionFilter *filter)
+    : x0_(x0), y0_(y0), width_(width), height_(height), filter_(filter), sums_(size_t(width) * height * 4, 0.0) {}
+
+void ImageBlock::clear() { std::fill(sums_.begin(), sums_.end(), 0.0); }
+
+void ImageBlock::put(float px, float py, const Color &L) {
+    float r = filter_->radius();
+    // Pixels whose centre (i + 0.5) lies within the radius of the sample.
+    int ix0 = std::max(x0_, int(std::ceil(px - 0.5f - r))), ix1 = std::min(x0_ + width_ - 1, int(std::floor(px - 0.5f + r)));
+    int iy0 = std::max(y0_, int(std::ceil(py - 0.5f - r))), iy1 = std::min(y0_ + height_ - 1, int(std::floor(py - 0.5f + r)));
+    float wx[40], wy[40];
+    int nx = ix1 - ix0 + 1, ny = iy1 - iy0 + 1;
+    if (nx <= 0 || ny <= 0 || nx > 40 || ny > 40) return;
+    for (int i = 0; i < nx; ++i) wx[i] = filter_->eval(float(ix0 + i) + 0.5f - px);
+    for (int j = 0; j < ny; ++j) wy[j] = filter_->eval(float(iy0 + j) + 0.5f - py);
+    for (int j = 0; j < ny; ++j) {
+        double *row = &sums_[(size_t(iy0 + j - y0_) * width_ + (ix0 - x0_)) * 4];
+        for (int i = 0; i < nx; ++i) {
+            double w = double(wx[i]) * wy[j];
+            row[4 * i] += w * L.x;
+            row[4 * i + 1] += w * L.y;
+            row[4 * i + 2] += w * L.z;
+            row[4 * i + 3] += w;
+        }
+    }
+}
+
+void ImageBlock::merge(const ImageBlock &o) {
+    int xa = std::max(x0_, o.x0_), xb = std::min(x0_ + width_, o.x0_ + o.width_);
+    int ya = std::max(y0_, o.y0_), yb = std::min(y0_ + height_, o.y0_ + o.height_);
+    for (int y = ya; y < yb; ++y)
+        for (int x = xa; x < xb; ++x) {
+            double *d = &sums_[(size_t(y - y0_) * width_ + (x - x0_)) * 4];
+            const double *s = &o.sums_[(size_t(y - o.y0_) * o.width_ + (x - o.x0_)) * 4];
+            for (int c = 0; c < 4; ++c) d[c] += s[c];
+        }
+}
+
+Image ImageBlock::resolve() const {
+    Image img(width_, height_, 3);
+    for (size_t i = 0; i < size_t(width_) * height_; ++i) {
+        double w = sums_[4 * i + 3];
+        for (int c = 0; c < 3; ++c) img.data[3 * i + c] = w > 0 ? float(sums_[4 * i + c] / w) : 0.f;
+    }
+    return img;
+}
+
+}  // namespace neepp

@@ -1,0 +1,150 @@
+#include "neepp/render/render_loop.h"
+
+#include <chrono>
+#include <cmath>
+#include <memory>
+#include <mutex>
+#include <tbb/enumerable_thread_specific.h>
+#include <tbb/global_control.h>
+#include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
+#include "neepp/integrators/integrator.h"
+#include "neepp/render/film.h"
+#include "neepp/render/progress_bar.h"
+#include "neepp/sampling/sampler.h"
+#include "neepp/scene/scene.h"
+
+namespace neepp {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+struct Tile {
+    int x0, y0, w, h;
+};
+
+std::vector<Tile> make_tiles(int width, int height, int size) {
+    std::vector<Tile> tiles;
+    for (int y = 0; y < height; y += size)
+        for (int x = 0; x < width; x += size) tiles.push_back({x, y, std::min(size, width - x), std::min(size, height - y)});
+    return tiles;
+}
+
+// Samples per pass: small passes first so NEE++ and the time estimate learn early, then growing
+// geometrically (capped) so per-pass overhead stays negligible.
+int next_pass_size(int done, int target, double seconds_per_spp, double remaining_s, bool timed) {
+    int size = std::clamp(done, 1, 32);
+    if (target > 0) size = std::min(size, target - done);
+    if (timed && seconds_per_spp > 0) {
+        double affordable = std::floor(remaining_s / seconds_per_spp);
+        size = int(std::min<double>(size, affordable));
+    }
+    return size;
+}
+
+}  // namespace
+
+RenderResult render(const Scene &scene, Integrator &integrator, const RenderJob &job) {
+    const PerspectiveCamera &cam = scene.camera;
+    const int W = cam.width, H = cam.height;
+    const bool timed = job.time_limit_s > 0;
+    if (job.spp <= 0 && !timed) throw std::invalid_argument("render: give a sample count or a time limit");
+
+    ReconstructionFilter filter(scene.settings.rfilter, scene.settings.rfilter_radius, scene.settings.rfilter_stddev);
+    const int border = int(std::ceil(filter.radius() - 0.5f));
+    ImageBlock accumulated(0, 0, W, H, &filter), pass_block(0, 0, W, H, &filter);
+    std::mutex merge_mutex;
+    std::vector<Tile> tiles = make_tiles(W, H, job.tile_size);
+    const std::unique_ptr<Sampler> prototype = make_sampler(job.sampler, job.seed);
+
+    int threads = job.threads > 0 ? job.threads : tbb::info::default_concurrency();
+    tbb::global_control limit(tbb::global_control::max_allowed_parallelism, size_t(threads));
+    tbb::task_arena arena(threads);
+
+    RenderResult result;
+    tbb::enumerable_thread_specific<RenderCounters> counters;
+    const Clock::time_point start = Clock::now();
+    auto elapsed = [&] { return std::chrono::duration<double>(Clock::now() - start).count(); };
+
+    std::atomic<int> tiles_done{0};
+    std::atomic<int> pass_size_now{0}, spp_done_now{0};
+    auto fraction = [&]() -> double {
+        if (timed && job.spp <= 0) return elapsed() / job.time_limit_s;
+        double spp_done = spp_done_now.load() + double(pass_size_now.load()) * tiles_done.load() / double(tiles.size());
+        double f = spp_done / double(job.spp);
+        return timed ? std::max(f, elapsed() / job.time_limit_s) : f;
+    };
+    ProgressBar bar(fraction, job.progress);
+
+    integrator.prepare(scene);
+    double seconds_per_spp = 0;
+    for (;;) {
+        if (job.cancel && job.cancel->load()) { result.stopped_by = "cancel"; break; }
+        double remaining = timed ? job.time_limit_s - elapsed() : 0;
+        if (timed && remaining <= 0) { result.stopped_by = "time"; break; }
+        int size = next_pass_size(result.spp, job.spp, seconds_per_spp, remaining, timed);
+        if (size <= 0) { result.stopped_by = (job.spp > 0 && result.spp >= job.spp) ? "spp" : "time"; break; }
+
+        const int s0 = result.spp;
+        pass_block.clear();
+        tiles_done = 0;
+        pass_size_now = size;
+        std::atomic<bool> aborted{false};
+        const double pass_start = elapsed();
+        arena.execute([&] {
+            tbb::parallel_for(tbb::blocked_range<size_t>(0, tiles.size(), 1), [&](const tbb::blocked_range<size_t> &r) {
+                std::unique_ptr<Sampler> sampler = prototype->clone();
+                RenderCounters &c = counters.local();
+                for (size_t ti = r.begin(); ti != r.end(); ++ti) {
+                    if (aborted.load(std::memory_order_relaxed)) return;
+                    if ((job.cancel && job.cancel->load()) || (timed && elapsed() > job.time_limit_s)) {
+                        aborted = true;
+                        return;
+                    }
+                    const Tile &t = tiles[ti];
+                    ImageBlock block(t.x0 - border, t.y0 - border, t.w + 2 * border, t.h + 2 * border, &filter);
+                    for (int y = t.y0; y < t.y0 + t.h; ++y)
+                        for (int x = t.x0; x < t.x0 + t.w; ++x)
+                            for (int s = s0; s < s0 + size; ++s) {
+                                sampler->start_sample(uint32_t(x), uint32_t(y), uint32_t(s));
+                                Vec2 jitter = sampler->next_2d();
+                                float px = float(x) + jitter.x, py = float(y) + jitter.y;
+                                Ray ray = cam.generate_ray({px / float(W), py / float(H)});
+                                Color L = integrator.Li(scene, ray, *sampler, c);
+                                if (!is_finite(L) || L.x < 0 || L.y < 0 || L.z < 0) {
+                                    ++c.invalid_samples;
+                                    L = Color(0.f);
+                                }
+                                block.put(px, py, L);
+                            }
+                    std::lock_guard<std::mutex> lock(merge_mutex);
+                    pass_block.merge(block);
+                    ++tiles_done;
+                }
+            });
+        });
+        if (aborted) {
+            // Keep a partial first pass rather than nothing at all: every pixel it reached is unbiased.
+            if (result.passes == 0) accumulated.merge(pass_block);
+            result.stopped_by = (job.cancel && job.cancel->load()) ? "cancel" : "time";
+            break;
+        }
+        accumulated.merge(pass_block);
+        result.spp += size;
+        spp_done_now = result.spp;
+        integrator.end_pass(scene, result.passes);
+        ++result.passes;
+        seconds_per_spp = (elapsed() - pass_start) / size;
+        if (job.spp > 0 && result.spp >= job.spp) { result.stopped_by = "spp"; break; }
+    }
+    pass_size_now = 0;
+    bar.finish();
+
+    result.render_time_s = elapsed();
+    for (const RenderCounters &c : counters) result.counters += c;
+    result.occlusion_time_s = double(result.counters.occlusion_ticks) * seconds_per_tick();
+    result.image = accumulated.resolve();
+    return result;
+}
+
+}  // namespace neepp

@@ -1,0 +1,39 @@
+// The render loop owns time: it renders the image in passes of whole-image samples, over tiles on a TBB
+// thread pool, until the sample count or the time budget is reached or it is cancelled (Ctrl-C), and
+// always hands back the image of the passes completed so far. Integrators get a hook between passes.
+#pragma once
+#include <atomic>
+#include <functional>
+#include <string>
+#include "neepp/io/image.h"
+#include "neepp/render/stats.h"
+
+namespace neepp {
+
+class Scene;
+class Integrator;
+
+struct RenderJob {
+    int spp = 16;                 // target samples per pixel; 0 = as many as time_limit_s allows
+    double time_limit_s = 0;      // 0 = no limit
+    uint64_t seed = 0;
+    int threads = 0;              // 0 = all cores
+    std::string sampler = "independent";
+    bool progress = false;        // draw a progress bar with ETA on stderr
+    const std::atomic<bool> *cancel = nullptr;  // set asynchronously (e.g. by SIGINT) to stop early
+    int tile_size = 32;
+};
+
+struct RenderResult {
+    Image image;
+    int spp = 0;                   // samples per pixel actually in the image
+    int passes = 0;
+    double render_time_s = 0;
+    RenderCounters counters;
+    double occlusion_time_s = 0;
+    std::string stopped_by = "spp";  // spp, time, cancel
+};
+
+RenderResult render(const Scene &scene, Integrator &integrator, const RenderJob &job);
+
+}  // namespace neepp

@@ -1,0 +1,55 @@
+#include "neepp/render/render_output.h"
+
+#include <filesystem>
+#include <sys/resource.h>
+#include "neepp/integrators/integrator.h"
+#include "neepp/scene/scene.h"
+
+namespace neepp {
+
+double peak_memory_mb() {
+    rusage usage{};
+    getrusage(RUSAGE_SELF, &usage);
+    return double(usage.ru_maxrss) / 1024.0;  // ru_maxrss is in kilobytes on Linux
+}
+
+nlohmann::json render_statistics(const Scene &scene, const Integrator &integrator, const RenderResult &r,
+                                 const RenderJob &job) {
+    const RenderCounters &c = r.counters;
+    double samples = double(r.spp) * scene.camera.width * scene.camera.height;
+    nlohmann::json j = {
+        {"scene", scene.source_path},
+        {"integrator", integrator.describe()},
+        {"spp", r.spp},
+        {"passes", r.passes},
+        {"stopped_by", r.stopped_by},
+        {"width", scene.camera.width},
+        {"height", scene.camera.height},
+        {"seed", job.seed},
+        {"threads", job.threads},
+        {"sampler", job.sampler},
+        {"render_time_s", r.render_time_s},
+        {"samples_per_s", r.render_time_s > 0 ? samples / r.render_time_s : 0.0},
+        {"rays", c.rays},
+        {"shadow_rays", c.shadow_rays},
+        {"shadow_rays_occluded", c.shadow_rays_occluded},
+        {"shadow_rays_skipped", c.shadow_rays_skipped},
+        {"occlusion_time_s", r.occlusion_time_s},
+        {"invalid_samples", c.invalid_samples},
+        {"triangles", scene.triangle_count()},
+        {"lights", scene.lights().size()},
+        {"peak_memory_mb", peak_memory_mb()},
+    };
+    if (auto extra = integrator.statistics(); !extra.empty()) j["integrator_statistics"] = extra;
+    return j;
+}
+
+std::string write_render_images(const std::string &exr_path, const Image &image) {
+    write_exr(exr_path, image);
+    std::filesystem::path png = exr_path;
+    png.replace_extension(".png");
+    write_png_srgb(png.string(), image);
+    return png.string();
+}
+
+}  // namespace neepp

@@ -1,0 +1,27 @@
+// Per-thread render counters, summed after each pass. Kept plain (no atomics) because each worker owns one.
+#pragma once
+#include <cstdint>
+
+namespace neepp {
+
+struct RenderCounters {
+    uint64_t rays = 0;               // closest-hit queries (camera and bounce rays)
+    uint64_t shadow_rays = 0;        // occlusion queries actually traced
+    uint64_t shadow_rays_occluded = 0;
+    uint64_t shadow_rays_skipped = 0;  // shadow tests answered without tracing (NEE++ rejection)
+    uint64_t occlusion_ticks = 0;    // time inside occlusion queries, in CPU timestamp ticks
+    uint64_t invalid_samples = 0;    // NaN/inf radiance samples dropped
+
+    RenderCounters &operator+=(const RenderCounters &o) {
+        rays += o.rays; shadow_rays += o.shadow_rays; shadow_rays_occluded += o.shadow_rays_occluded;
+        shadow_rays_skipped += o.shadow_rays_skipped; occlusion_ticks += o.occlusion_ticks;
+        invalid_samples += o.invalid_samples;
+        return *this;
+    }
+};
+
+// Seconds per tick of the CPU timestamp counter, calibrated once against the steady clock.
+double seconds_per_tick();
+uint64_t read_ticks();
+
+}  // namespace neepp

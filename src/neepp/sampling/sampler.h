@@ -1,0 +1,62 @@
+// Sample generators for the render loop. A sampler is set up for one (pixel, sample index) and then
+// hands out the dimensions of that path in order; the same setup gives the same numbers on any thread.
+#pragma once
+#include <cstdint>
+#include <memory>
+#include <string>
+#include "neepp/math/vec.h"
+#include "neepp/sampling/rng.h"
+
+namespace neepp {
+
+class Sampler {
+public:
+    virtual ~Sampler() = default;
+    virtual void start_sample(uint32_t px, uint32_t py, uint32_t sample_index) = 0;
+    virtual float next_1d() = 0;
+    virtual Vec2 next_2d() = 0;
+    virtual std::unique_ptr<Sampler> clone() const = 0;
+    virtual std::string name() const = 0;
+};
+
+// Independent uniform random numbers (Mitsuba's `independent`).
+class IndependentSampler final : public Sampler {
+public:
+    explicit IndependentSampler(uint64_t seed) : seed_(seed) {}
+    void start_sample(uint32_t px, uint32_t py, uint32_t sample_index) override {
+        uint64_t pixel = (uint64_t(py) << 32) | px;
+        rng_.seed(mix_bits(seed_ ^ mix_bits(pixel)), mix_bits(sample_index + (seed_ << 32)));
+    }
+    float next_1d() override { return rng_.next_float(); }
+    Vec2 next_2d() override { return rng_.next_2d(); }
+    std::unique_ptr<Sampler> clone() const override { return std::make_unique<IndependentSampler>(seed_); }
+    std::string name() const override { return "independent"; }
+
+private:
+    uint64_t seed_;
+    PCG32 rng_;
+};
+
+// Per-pixel randomized Sobol (Owen-scrambled, Laine-Karras hashing) over the sample index, with each
+// dimension pair decorrelated by a hash. Low discrepancy in the first dimensions of each pixel.
+class SobolSampler final : public Sampler {
+public:
+    explicit SobolSampler(uint64_t seed) : seed_(seed) {}
+    void start_sample(uint32_t px, uint32_t py, uint32_t sample_index) override {
+        pixel_hash_ = mix_bits(seed_ ^ mix_bits((uint64_t(py) << 32) | px));
+        index_ = sample_index;
+        dim_ = 0;
+    }
+    float next_1d() override;
+    Vec2 next_2d() override;
+    std::unique_ptr<Sampler> clone() const override { return std::make_unique<SobolSampler>(seed_); }
+    std::string name() const override { return "sobol"; }
+
+private:
+    uint64_t seed_, pixel_hash_ = 0;
+    uint32_t index_ = 0, dim_ = 0;
+};
+
+std::unique_ptr<Sampler> make_sampler(const std::string &name, uint64_t seed);
+
+}  // namespace neepp

@@ -1,0 +1,124 @@
+#include "neepp/scene/scene.h"
+
+#include <cstdio>
+#include <stdexcept>
+#include <string>
+
+namespace neepp {
+namespace {
+
+// Embree calls this from C code, so it must not throw; build() checks the device error afterwards.
+void embree_error(void *, RTCError code, const char *message) {
+    std::fprintf(stderr, "Embree error %d: %s\n", int(code), message ? message : "");
+}
+
+}  // namespace
+
+Scene::Scene() {
+    device_ = rtcNewDevice(nullptr);
+    if (!device_) throw std::runtime_error("could not create an Embree device");
+    rtcSetDeviceErrorFunction(device_, embree_error, nullptr);
+}
+
+Scene::~Scene() {
+    if (rtc_scene_) rtcReleaseScene(rtc_scene_);
+    if (device_) rtcReleaseDevice(device_);
+}
+
+void Scene::add_shape(std::unique_ptr<Shape> shape) { shapes_.push_back(std::move(shape)); }
+
+const Light *Scene::add_light(LightPtr light) {
+    light->index = uint32_t(lights_.size());
+    lights_.push_back(std::move(light));
+    return lights_.back().get();
+}
+
+std::vector<const Light *> Scene::light_pointers() const {
+    std::vector<const Light *> r;
+    for (const auto &l : lights_) r.push_back(l.get());
+    return r;
+}
+
+size_t Scene::triangle_count() const {
+    size_t n = 0;
+    for (const auto &s : shapes_) n += s->triangle_count();
+    return n;
+}
+
+void Scene::build() {
+    if (shapes_.empty() && lights_.empty()) throw std::runtime_error("the scene is empty: no shapes and no lights");
+    rtc_scene_ = rtcNewScene(device_);
+    rtcSetSceneBuildQuality(rtc_scene_, RTC_BUILD_QUALITY_HIGH);
+    bounds_ = BBox();
+    for (size_t i = 0; i < shapes_.size(); ++i) {
+        Shape &s = *shapes_[i];
+        s.finalize();
+        RTCGeometry geom;
+        if (s.kind == Shape::Kind::Sphere) {
+            geom = rtcNewGeometry(device_, RTC_GEOMETRY_TYPE_SPHERE_POINT);
+            float *v = (float *)rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT4,
+                                                        4 * sizeof(float), 1);
+            v[0] = s.center.x; v[1] = s.center.y; v[2] = s.center.z; v[3] = s.radius;
+        } else {
+            if (s.indices.empty()) continue;  // nothing to intersect; kept so ids stay stable
+            geom = rtcNewGeometry(device_, RTC_GEOMETRY_TYPE_TRIANGLE);
+            float *v = (float *)rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3,
+                                                        3 * sizeof(float), s.positions.size());
+            for (size_t k = 0; k < s.positions.size(); ++k) {
+                v[3 * k] = s.positions[k].x; v[3 * k + 1] = s.positions[k].y; v[3 * k + 2] = s.positions[k].z;
+            }
+            uint32_t *idx = (uint32_t *)rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
+                                                                3 * sizeof(uint32_t), s.triangle_count());
+            std::copy(s.indices.begin(), s.indices.end(), idx);
+        }
+        rtcCommitGeometry(geom);
+        rtcAttachGeometryByID(rtc_scene_, geom, unsigned(i));
+        rtcReleaseGeometry(geom);
+        bounds_.expand(s.bounds());
+    }
+    rtcCommitScene(rtc_scene_);
+    if (RTCError err = rtcGetDeviceError(device_); err != RTC_ERROR_NONE)
+        throw std::runtime_error("Embree failed to build the scene (error " + std::to_string(int(err)) + ")");
+    if (!bounds_.valid()) bounds_ = BBox{Vec3(-1.f), Vec3(1.f)};
+    infinite_lights_.clear();
+    for (auto &l : lights_) {
+        l->set_scene_bounds(bounds_);
+        if (l->is_infinite()) infinite_lights_.push_back(l.get());
+    }
+}
+
+bool Scene::intersect(const Ray &ray, SurfaceInteraction &si) const {
+    RTCIntersectContext ctx;
+    rtcInitIntersectContext(&ctx);
+    RTCRayHit rh;
+    rh.ray.org_x = ray.o.x; rh.ray.org_y = ray.o.y; rh.ray.org_z = ray.o.z;
+    rh.ray.dir_x = ray.d.x; rh.ray.dir_y = ray.d.y; rh.ray.dir_z = ray.d.z;
+    rh.ray.tnear = ray.tmin; rh.ray.tfar = ray.tmax;
+    rh.ray.time = 0; rh.ray.mask = 0xFFFFFFFFu; rh.ray.id = 0; rh.ray.flags = 0;
+    rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+    rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+    rtcIntersect1(rtc_scene_, &ctx, &rh);
+    if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) {
+        si.shape = nullptr;
+        return false;
+    }
+    const Shape &s = *shapes_[rh.hit.geomID];
+    s.fill_interaction(rh.hit.primID, rh.hit.u, rh.hit.v, Vec3(rh.hit.Ng_x, rh.hit.Ng_y, rh.hit.Ng_z), ray,
+                       rh.ray.tfar, si);
+    si.wi = si.to_local(-ray.d);
+    return true;
+}
+
+bool Scene::occluded(const Ray &ray) const {
+    RTCIntersectContext ctx;
+    rtcInitIntersectContext(&ctx);
+    RTCRay r;
+    r.org_x = ray.o.x; r.org_y = ray.o.y; r.org_z = ray.o.z;
+    r.dir_x = ray.d.x; r.dir_y = ray.d.y; r.dir_z = ray.d.z;
+    r.tnear = ray.tmin; r.tfar = ray.tmax;
+    r.time = 0; r.mask = 0xFFFFFFFFu; r.id = 0; r.flags = 0;
+    rtcOccluded1(rtc_scene_, &ctx, &r);
+    return r.tfar < 0;  // Embree sets tfar to -inf on a hit
+}
+
+}  // namespace neepp

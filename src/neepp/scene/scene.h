@@ -1,0 +1,62 @@
+// The scene: shapes in an Embree BVH, lights, camera and the render settings read from the scene file.
+#pragma once
+#include <map>
+#include <memory>
+#include <string>
+#include <vector>
+#include <embree3/rtcore.h>
+#include "neepp/lights/light.h"
+#include "neepp/scene/camera.h"
+#include "neepp/scene/shape.h"
+
+namespace neepp {
+
+// Settings a Mitsuba scene file carries besides geometry (integrator, sampler, film, filter).
+struct RenderSettings {
+    std::string integrator = "path";
+    std::map<std::string, std::string> integrator_options;  // as written in the file, e.g. max_depth=17
+    std::string sampler = "independent";
+    int spp = 16;
+    uint64_t seed = 0;
+    std::string rfilter = "gaussian";  // Mitsuba's hdrfilm default
+    float rfilter_radius = 2.f;        // box 0.5, tent 1, gaussian 4 * stddev (0.5)
+    float rfilter_stddev = 0.5f;
+};
+
+class Scene {
+public:
+    Scene();
+    ~Scene();
+    Scene(const Scene &) = delete;
+    Scene &operator=(const Scene &) = delete;
+
+    void add_shape(std::unique_ptr<Shape> shape);
+    // Takes ownership of a light; area lights should be added through add_area_light.
+    const Light *add_light(LightPtr light);
+    // Finalizes shapes, builds the Embree scene and tells lights the scene bounds. Throws on an empty scene.
+    void build();
+
+    bool intersect(const Ray &ray, SurfaceInteraction &si) const;
+    bool occluded(const Ray &ray) const;
+
+    const std::vector<std::unique_ptr<Shape>> &shapes() const { return shapes_; }
+    const std::vector<LightPtr> &lights() const { return lights_; }
+    std::vector<const Light *> light_pointers() const;
+    const std::vector<const Light *> &infinite_lights() const { return infinite_lights_; }
+    const BBox &bounds() const { return bounds_; }
+    size_t triangle_count() const;
+
+    PerspectiveCamera camera;
+    RenderSettings settings;
+    std::string source_path;  // scene file it came from, for messages and statistics
+
+private:
+    RTCDevice device_ = nullptr;
+    RTCScene rtc_scene_ = nullptr;
+    std::vector<std::unique_ptr<Shape>> shapes_;
+    std::vector<LightPtr> lights_;
+    std::vector<const Light *> infinite_lights_;
+    BBox bounds_;
+};
+
+}  // namespace neepp

@@ -1,0 +1,60 @@
+// A shape of the scene: a triangle mesh in world space (or an analytic sphere), its material, and the
+// area light it carries if it emits.
+#pragma once
+#include <memory>
+#include <string>
+#include <vector>
+#include "neepp/materials/bsdf.h"
+#include "neepp/math/bbox.h"
+#include "neepp/math/distribution.h"
+#include "neepp/scene/interaction.h"
+
+namespace neepp {
+
+class Light;
+
+struct PositionSample {
+    Vec3 p, n;      // point on the surface and its geometric normal
+    Vec2 uv;
+    float pdf = 0;  // area density
+};
+
+struct Shape {
+    enum class Kind { Mesh, Sphere };
+    Kind kind = Kind::Mesh;
+    std::string id;
+
+    // Mesh data, world space. normals (per vertex) and uvs are empty when absent.
+    std::vector<Vec3> positions, normals;
+    std::vector<Vec2> uvs;
+    std::vector<uint32_t> indices;
+    bool face_normals = false;  // ignore vertex normals (Mitsuba's face_normals)
+    bool flip_normals = false;
+
+    // Sphere data.
+    Vec3 center;
+    float radius = 0;
+
+    BSDFPtr bsdf;
+    const Light *area_light = nullptr;  // set when the scene creates an area light for this shape
+
+    // Call once after the geometry is final: computes the area and the triangle-area distribution.
+    void finalize();
+    size_t triangle_count() const { return indices.size() / 3; }
+    float surface_area() const { return area_; }
+    BBox bounds() const;
+
+    // Uniform sampling of a point by area.
+    PositionSample sample_position(Vec2 u) const;
+    float pdf_position() const { return area_ > 0 ? 1.f / area_ : 0.f; }
+
+    // Completes a hit record from Embree's primitive index and barycentrics (or sphere hit).
+    void fill_interaction(uint32_t prim, float b1, float b2, const Vec3 &ng_embree, const Ray &ray, float t,
+                          SurfaceInteraction &si) const;
+
+private:
+    float area_ = 0;
+    Distribution1D triangle_distribution_;
+};
+
+}  // namespace neepp

@@ -1,0 +1,152 @@
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <stdexcept>
+#include <string>
+
+#include "neepp/io/image.h"
+
+using namespace neepp;
+
+namespace {
+
+std::string temp_path(const std::string &name) {
+    return (std::filesystem::temp_directory_path() / ("neepp_test_image_" + name)).string();
+}
+
+Image ramp(int w, int h, int c) {
+    Image img(w, h, c);
+    for (size_t i = 0; i < img.data.size(); ++i) img.data[i] = 0.37f * float(i) - 1.5f;
+    return img;
+}
+
+// Expects fn to throw std::runtime_error whose message names path.
+template <typename Fn>
+void expect_error_naming(const std::string &path, Fn fn) {
+    try {
+        fn();
+        FAIL() << "no exception for " << path;
+    } catch (const std::runtime_error &e) {
+        EXPECT_NE(std::string(e.what()).find(path), std::string::npos) << e.what();
+    }
+}
+
+}  // namespace
+
+TEST(Image, ExrFloatRoundTripIsExact) {
+    for (int c : {1, 3, 4}) {
+        Image img = ramp(5, 3, c);
+        std::string path = temp_path("float.exr");
+        write_exr(path, img, false);
+        Image back = read_image(path);
+        EXPECT_EQ(back.width, 5);
+        EXPECT_EQ(back.height, 3);
+        EXPECT_EQ(back.channels, c);
+        EXPECT_FALSE(back.srgb_encoded);
+        EXPECT_EQ(back.data, img.data);
+        std::filesystem::remove(path);
+    }
+}
+
+TEST(Image, ExrHalfRoundTripWithinHalfPrecision) {
+    Image img = ramp(4, 4, 3);
+    std::string path = temp_path("half.exr");
+    write_exr(path, img, true);
+    Image back = read_image(path);
+    ASSERT_EQ(back.data.size(), img.data.size());
+    for (size_t i = 0; i < img.data.size(); ++i)
+        EXPECT_NEAR(back.data[i], img.data[i], std::abs(img.data[i]) * 1e-3f + 1e-6f);
+    std::filesystem::remove(path);
+}
+
+TEST(Image, PngWriteThenReadIsSrgbEncoded) {
+    Image img(3, 2, 3);
+    const float values[] = {0.f, 0.001f, 0.0031308f, 0.05f, 0.2f, 0.5f, 0.8f, 1.f, 2.f};
+    for (size_t i = 0; i < img.data.size(); ++i) img.data[i] = values[i % 9];
+    img.at(2, 1, 0) = -1.f;  // clamped to 0
+    std::string path = temp_path("srgb.png");
+    write_png_srgb(path, img, 1.f);
+    Image back = read_image(path);
+    ASSERT_EQ(back.width, 3);
+    ASSERT_EQ(back.height, 2);
+    ASSERT_EQ(back.channels, 3);
+    EXPECT_TRUE(back.srgb_encoded);
+    for (int y = 0; y < 2; ++y)
+        for (int x = 0; x < 3; ++x)
+            for (int c = 0; c < 3; ++c) {
+                float expected = std::round(linear_to_srgb(std::clamp(img.at(x, y, c), 0.f, 1.f)) * 255.f);
+                EXPECT_FLOAT_EQ(back.at(x, y, c) * 255.f, expected) << x << "," << y << "," << c;
+            }
+    std::filesystem::remove(path);
+}
+
+TEST(Image, PngExposureScalesBeforeEncoding) {
+    Image img(1, 1, 3);
+    img.data = {0.25f, 0.5f, 1.f};
+    std::string path = temp_path("exposure.png");
+    write_png_srgb(path, img, 2.f);
+    Image back = read_image(path);
+    EXPECT_FLOAT_EQ(back.data[0] * 255.f, std::round(linear_to_srgb(0.5f) * 255.f));
+    EXPECT_FLOAT_EQ(back.data[1], 1.f);
+    EXPECT_FLOAT_EQ(back.data[2], 1.f);
+    std::filesystem::remove(path);
+}
+
+TEST(Image, GrayAlphaPngKeepsAlphaLinear) {
+    Image img(2, 1, 2);
+    img.data = {0.2f, 0.4f, 1.f, 1.f};
+    std::string path = temp_path("ya.png");
+    write_png_srgb(path, img);
+    Image back = read_image(path);
+    ASSERT_EQ(back.channels, 2);
+    EXPECT_TRUE(back.has_alpha());
+    EXPECT_EQ(back.color_channels(), 1);
+    EXPECT_FLOAT_EQ(back.data[1] * 255.f, std::round(0.4f * 255.f));
+    EXPECT_FLOAT_EQ(back.data[0] * 255.f, std::round(linear_to_srgb(0.2f) * 255.f));
+    std::filesystem::remove(path);
+}
+
+TEST(Image, MissingFileNamesPath) {
+    std::string path = temp_path("does_not_exist.exr");
+    expect_error_naming(path, [&] { read_image(path); });
+}
+
+TEST(Image, CorruptFilesNamePath) {
+    std::string png = temp_path("corrupt.png");
+    std::ofstream(png, std::ios::binary) << "this is not an image";
+    expect_error_naming(png, [&] { read_image(png); });
+    std::filesystem::remove(png);
+
+    // A valid EXR magic number followed by garbage must fail inside OpenEXR, not crash.
+    std::string exr = temp_path("corrupt.exr");
+    std::ofstream(exr, std::ios::binary) << "\x76\x2f\x31\x01 garbage garbage garbage";
+    expect_error_naming(exr, [&] { read_image(exr); });
+    std::filesystem::remove(exr);
+
+    std::string jpg = temp_path("corrupt.jpg");  // JPEG start-of-image marker, then garbage
+    std::ofstream(jpg, std::ios::binary) << "\xff\xd8\xff\xe0 garbage";
+    expect_error_naming(jpg, [&] { read_image(jpg); });
+    std::filesystem::remove(jpg);
+}
+
+TEST(Image, WriteToUnwritablePathNamesPath) {
+    std::string path = "/nonexistent_dir_neepp/out.exr";
+    expect_error_naming(path, [&] { write_exr(path, ramp(2, 2, 3)); });
+    expect_error_naming("/nonexistent_dir_neepp/out.png", [&] {
+        write_png_srgb("/nonexistent_dir_neepp/out.png", ramp(2, 2, 3));
+    });
+}
+
+TEST(Image, SrgbTransferFunctionsArePiecewiseAndInverse) {
+    EXPECT_FLOAT_EQ(srgb_to_linear(0.04045f), 0.04045f / 12.92f);
+    EXPECT_NEAR(srgb_to_linear(0.5f), 0.21404114f, 1e-7f);
+    EXPECT_FLOAT_EQ(srgb_to_linear(1.f), 1.f);
+    EXPECT_FLOAT_EQ(linear_to_srgb(0.002f), 0.002f * 12.92f);
+    EXPECT_NEAR(linear_to_srgb(0.21404114f), 0.5f, 1e-6f);
+    for (int i = 0; i <= 255; ++i) {
+        float v = i / 255.f;
+        EXPECT_NEAR(linear_to_srgb(srgb_to_linear(v)), v, 2e-6f);
+    }
+}

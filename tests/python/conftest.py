@@ -1,0 +1,53 @@
+"""pytest setup for the Python test suite (tests/python).
+
+Puts <repo>/python on sys.path and offers fixtures that locate the neepp binary, the shared scenes
+and Mitsuba 3, skipping with a clear message when one is missing. Run with the project's venv:
+
+    scripts/setup_python.sh && .venv/bin/python -m pytest tests/python -v -s
+"""
+from __future__ import annotations
+
+import os
+import sys
+from pathlib import Path
+
+import pytest
+
+REPO = Path(__file__).resolve().parents[2]
+sys.path.insert(0, str(REPO / "python"))
+
+from neepp_tools import SCENES_DIR, runner  # noqa: E402
+
+
+@pytest.fixture(scope="session")
+def scenes_dir() -> Path:
+    d = Path(os.environ.get("NEEPP_SCENES_DIR", SCENES_DIR))
+    if not (d / "cornell-box" / "scene.xml").exists():
+        pytest.skip(f"shared scenes not found at {d} (expected ../shared/scenes beside the repo)")
+    return d
+
+
+@pytest.fixture(scope="session")
+def neepp_bin() -> Path:
+    b = runner.find_neepp()
+    if b is None:
+        pytest.skip("neepp binary not found: set NEEPP_BIN or build it into build/neepp "
+                    "(cmake -S . -B build -G Ninja && cmake --build build)")
+    return b
+
+
+@pytest.fixture(scope="session")
+def mitsuba_variant() -> str:
+    """llvm_ad_rgb when libLLVM 19 is there (fast), else scalar_rgb."""
+    ok, why = runner.mitsuba_available("llvm_ad_rgb")
+    if ok:
+        return "llvm_ad_rgb"
+    ok, why2 = runner.mitsuba_available("scalar_rgb")
+    if ok:
+        return "scalar_rgb"
+    pytest.skip(f"Mitsuba 3 not usable: {why2} (run scripts/setup_python.sh)")
+
+
+@pytest.fixture(scope="session")
+def work_dir(tmp_path_factory) -> Path:
+    return tmp_path_factory.mktemp("vs_mitsuba")

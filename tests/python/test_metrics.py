@@ -1,0 +1,56 @@
+"""neepp_tools.metrics on small hand-computed arrays."""
+import math
+
+import numpy as np
+import pytest
+
+from neepp_tools import metrics
+
+
+def test_relmse_hand_computed():
+    ref = np.array([[[1.0, 0.0, 0.1]]])  # one pixel
+    img = np.array([[[2.0, 0.1, 0.1]]])
+    # (1)^2/(1+0.01), (0.1)^2/(0+0.01), 0
+    expected = (1 / 1.01 + 0.01 / 0.01 + 0.0) / 3
+    assert metrics.relmse(img, ref) == pytest.approx(expected, rel=1e-12)
+    assert metrics.relmse_map(img, ref).shape == (1, 1)
+    assert metrics.relmse_map(img, ref)[0, 0] == pytest.approx(expected, rel=1e-12)
+
+
+def test_relmse_two_pixels_and_identity():
+    ref = np.ones((1, 2, 3))
+    img = np.ones((1, 2, 3))
+    img[0, 1, :] = 0.5
+    # three channels of the second pixel: 0.25/1.01, the first pixel 0
+    assert metrics.relmse(img, ref) == pytest.approx(0.25 / 1.01 / 2, rel=1e-12)
+    assert metrics.relmse(ref, ref) == 0.0
+
+
+def test_rmse_mare_mean():
+    ref = np.array([[[1.0, 2.0, 3.0]], [[0.0, 0.0, 0.0]]])  # (2, 1, 3)
+    img = np.array([[[1.0, 2.0, 5.0]], [[0.0, 0.0, 0.01]]])
+    assert metrics.rmse(img, ref) == pytest.approx(math.sqrt((4 + 1e-4) / 6), rel=1e-12)
+    assert metrics.mean_abs_rel_error(img, ref) == pytest.approx((2 / 3.01 + 0.01 / 0.01) / 6, rel=1e-12)
+    assert metrics.image_mean(img) == pytest.approx(8.01 / 6, rel=1e-12)
+
+
+def test_shape_mismatch_raises():
+    with pytest.raises(ValueError):
+        metrics.relmse(np.zeros((2, 2, 3)), np.zeros((2, 3, 3)))
+
+
+def test_mean_stderr_matches_iid_noise():
+    rng = np.random.default_rng(1)
+    ref = np.full((256, 256, 3), 2.0)
+    sigma = 0.5
+    img = ref + rng.normal(0, sigma, size=(256, 256, 1)).repeat(3, axis=-1)
+    se = metrics.mean_stderr(img, ref, block=8)
+    expected = sigma / math.sqrt(256 * 256)
+    assert se == pytest.approx(expected, rel=0.15)
+
+
+def test_relmse_of_unbiased_noise_is_variance_over_r2():
+    rng = np.random.default_rng(2)
+    ref = np.full((200, 200, 3), 1.0)
+    img = ref + rng.normal(0, 0.1, size=ref.shape)
+    assert metrics.relmse(img, ref) == pytest.approx(0.01 / 1.01, rel=0.02)
