@@ -64,6 +64,21 @@ def mean_stderr(img, ref, block: int = 8) -> float:
     return float(np.std(tiles, ddof=1) / np.sqrt(tiles.size))
 
 
+def relmse_stderr(img, ref, block: int = 8, eps: float = EPS) -> float:
+    """Standard error of relmse(img, ref) from its spread over block x block tiles (absolute, not relative).
+
+    At low spp the per-render relMSE is dominated by rare bright samples (fireflies) and fluctuates
+    from seed to seed by several percent; this estimates that fluctuation from one image.
+    """
+    e = relmse_map(img, ref, eps)
+    h, w = e.shape
+    hb, wb = h // block, w // block
+    if hb * wb < 2:
+        return float(np.std(e) / np.sqrt(e.size))
+    tiles = e[: hb * block, : wb * block].reshape(hb, block, wb, block).mean(axis=(1, 3))
+    return float(np.std(tiles, ddof=1) / np.sqrt(tiles.size))
+
+
 def all_metrics(img, ref) -> dict:
     return {
         "relmse": relmse(img, ref),
@@ -73,4 +88,5 @@ def all_metrics(img, ref) -> dict:
         "ref_mean": image_mean(ref),
         "mean_ratio": image_mean(img) / image_mean(ref) if image_mean(ref) != 0 else float("nan"),
         "mean_stderr": mean_stderr(img, ref),
+        "relmse_stderr": relmse_stderr(img, ref),
     }

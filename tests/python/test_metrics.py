@@ -54,3 +54,13 @@ def test_relmse_of_unbiased_noise_is_variance_over_r2():
     ref = np.full((200, 200, 3), 1.0)
     img = ref + rng.normal(0, 0.1, size=ref.shape)
     assert metrics.relmse(img, ref) == pytest.approx(0.01 / 1.01, rel=0.02)
+
+
+def test_relmse_stderr_matches_iid_noise():
+    rng = np.random.default_rng(3)
+    ref = np.full((256, 256, 3), 1.0)
+    img = ref + rng.normal(0, 0.1, size=ref.shape)
+    # per-pixel relMSE is (0.1^2/1.01) * chi2_3 / 3, whose std is mean * sqrt(2/3)
+    m = 0.01 / 1.01
+    expected = m * np.sqrt(2 / 3) / 256
+    assert metrics.relmse_stderr(img, ref) == pytest.approx(expected, rel=0.15)
