@@ -5,7 +5,7 @@
 set -euo pipefail
 
 PKGS=(cmake ninja-build g++ pkg-config libembree-dev libtbb-dev libopenexr-dev libpugixml-dev
-      libtinyobjloader-dev libcli11-dev libfmt-dev libstb-dev nlohmann-json3-dev libgtest-dev
+      libjpeg-dev libcli11-dev libfmt-dev libstb-dev nlohmann-json3-dev libgtest-dev
       python3-venv "$@")
 
 missing=()

@@ -11,6 +11,8 @@
 
 namespace neepp::testing {
 
+using OptionMap = std::map<std::string, std::string>;
+
 // Writes xml to a fresh file in the temp directory and returns its path.
 inline std::string write_temp_scene(const std::string &xml, const std::string &name = "scene.xml") {
     static int counter = 0;

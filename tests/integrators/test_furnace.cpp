@@ -40,6 +40,8 @@ struct FurnaceCase {
     std::map<std::string, std::string> options;
 };
 
+void PrintTo(const FurnaceCase &c, std::ostream *os) { *os << c.name; }
+
 class Furnace : public ::testing::TestWithParam<FurnaceCase> {};
 
 TEST_P(Furnace, InnerSphereMatchesGeometricSeries) {
@@ -75,7 +77,7 @@ TEST(Furnace, DiffuseSphereUnderConstantEnvironment) {
     <bsdf type="diffuse"><rgb name="reflectance" value="0.6, 0.3, 0.9"/></bsdf></shape>
   <emitter type="constant"><rgb name="radiance" value="1"/></emitter>
 </scene>)";
-        auto out = render_scene_file(write_temp_scene(xml), 256, 3, Options({{"nee", nee ? "true" : "false"}, {"max_depth", "2"}}));
+        auto out = render_scene_file(write_temp_scene(xml), 256, 3, Options(OptionMap{{"nee", nee ? "true" : "false"}, {"max_depth", "2"}}));
         // The 8x8 image at fov 10 from distance 10 sees only the sphere (half-width 0.87 < 1.5).
         const float expected[3] = {0.6f, 0.3f, 0.9f};
         for (int c = 0; c < 3; ++c) {

@@ -13,7 +13,7 @@ const char *kRoomXml = R"(<scene version="3.0.0">
   <integrator type="path"><integer name="max_depth" value="6"/></integrator>
   <sensor type="perspective">
     <float name="fov" value="60"/>
-    <transform name="to_world"><lookat origin="0,1,3.5" target="0,1,0" up="0,1,0"/></transform>
+    <transform name="to_world"><lookat origin="0,1,1.9" target="0,0.8,0" up="0,1,0"/></transform>
     <film type="hdrfilm"><integer name="width" value="24"/><integer name="height" value="18"/><rfilter type="box"/></film>
   </sensor>
   <bsdf type="twosided" id="white"><bsdf type="diffuse"><rgb name="reflectance" value="0.7"/></bsdf></bsdf>
@@ -65,8 +65,8 @@ Moments block_moments(const std::string &path, const Options &o, int seeds, int 
 
 TEST(PathIntegrator, NeeMisAgreesWithBsdfSampling) {
     std::string path = write_temp_scene(kRoomXml);
-    Moments nee = block_moments(path, Options({{"nee", "true"}}), 6, 48);
-    Moments bsdf = block_moments(path, Options({{"nee", "false"}}), 6, 96);
+    Moments nee = block_moments(path, Options(OptionMap{{"nee", "true"}}), 6, 48);
+    Moments bsdf = block_moments(path, Options(OptionMap{{"nee", "false"}}), 6, 96);
     size_t nb = nee.mean.size();
     // Bonferroni over the blocks at a 1e-3 family-wise level: |z| < 3.9 for 12 blocks (t with 5 dof is
     // heavier-tailed, so use a generous bound of 5).

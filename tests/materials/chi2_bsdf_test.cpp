@@ -95,7 +95,7 @@ TEST_P(Chi2BSDF, SamplingMatchesPdf) {
     Chi2Result r = chi2_test(*bsdf, incident(c.theta_deg), cfg);
     SCOPED_TRACE(c.name + " theta=" + std::to_string(c.theta_deg) + ": " + r.describe());
     ASSERT_TRUE(r.error.empty());
-    // Bonferroni correction over all cases, as the brief for Mitsuba's chi2 tests.
+    // Bonferroni correction over all cases, so that one run of the suite has a 1% false-alarm rate.
     EXPECT_GT(r.p_value, 0.01 / double(cases().size()));
     // Sampling density may lose mass (directions below the horizon) but never create it.
     EXPECT_LE(r.pdf_integral, 1.0 + 2e-3);

@@ -96,7 +96,13 @@ void Factories::shape(const XmlNode &node, Scene &scene) {
     try {
         if (t == "obj" || t == "ply") {
             std::string path = node.resolve_path(node.get_string("filename"));
-            set_mesh(*s, t == "obj" ? read_obj(path) : read_ply(path), to_world);
+            MeshData mesh;
+            try {
+                mesh = t == "obj" ? read_obj(path) : read_ply(path);
+            } catch (const std::exception &e) {  // the mesh's own error, located at the shape using it
+                throw node.error(e.what());
+            }
+            set_mesh(*s, std::move(mesh), to_world);
         } else if (t == "rectangle") {
             set_mesh(*s, rectangle_mesh(), to_world);
         } else if (t == "cube") {
@@ -105,6 +111,7 @@ void Factories::shape(const XmlNode &node, Scene &scene) {
             s->kind = Shape::Kind::Sphere;
             Vec3 c = node.get_vector("center", Vec3(0.f));
             float r = node.get_float("radius", 1.f);
+            if (!(r > 0) || !std::isfinite(r)) throw node.error("sphere radius must be positive and finite");
             // A to_world on a sphere may translate and scale uniformly (Mitsuba allows more; we refuse).
             s->center = to_world.point(c);
             Vec3 ex = to_world.vector(Vec3(r, 0, 0)), ey = to_world.vector(Vec3(0, r, 0));

@@ -28,9 +28,7 @@ TexturePtr Factories::texture(const XmlNode &node) {
         std::string path = node.resolve_path(node.get_string("filename"));
         try {
             tex = BitmapTexture::load(path, o);
-        } catch (const SceneError &) {
-            throw;
-        } catch (const std::exception &e) {
+        } catch (const std::exception &e) {  // missing or corrupt image: name the element that wants it
             throw node.error(e.what());
         }
     } else if (node.type == "checkerboard") {

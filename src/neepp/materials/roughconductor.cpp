@@ -37,7 +37,7 @@ float RoughConductorBSDF::pdf(const BSDFContext &, const SurfaceInteraction &si,
     if (wi.z <= 0.f || wo.z <= 0.f || dot(wi, m) <= 0.f || dot(wo, m) <= 0.f) return 0.f;
     MicrofacetDistribution distr = distribution(si);
     // Reflection Jacobian dm/dwo = 1 / (4 wo.m); with visible normals wo.m = wi.m cancels.
-    if (sample_visible_) return distr.eval(m) * distr.smith_g1(wo, m) / (4.f * wi.z);
+    if (sample_visible_) return distr.eval(m) * distr.smith_g1(wi, m) / (4.f * wi.z);
     return distr.pdf(wi, m) / (4.f * dot(wo, m));
 }
 

@@ -1,0 +1,10 @@
+#!/usr/bin/env bash
+# The whole test suite: installs what it needs (Debian packages, the Python venv with Mitsuba 3),
+# builds, then runs the C++ tests (ctest) and the Python tests (pytest: CLI, comparison with Mitsuba 3).
+set -euo pipefail
+ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
+"$ROOT/scripts/install_deps.sh"
+"$ROOT/scripts/setup_python.sh"
+"$ROOT/scripts/build.sh"
+ctest --test-dir "$ROOT/build" --output-on-failure -j2
+cd "$ROOT" && NEEPP_BIN="$ROOT/build/neepp" "$ROOT/.venv/bin/python" -m pytest tests/python -q -rs

@@ -1,0 +1,108 @@
+// Bad input gets a clear error naming the file (and line where there is one), never a crash or a hang.
+#include <gtest/gtest.h>
+#include <fstream>
+#include "neepp/io/scene_error.h"
+#include "test_scenes.h"
+
+using namespace neepp;
+using namespace neepp::testing;
+
+namespace {
+
+const char *kCamera = R"(<sensor type="perspective"><film type="hdrfilm"><integer name="width" value="8"/><integer name="height" value="8"/></film></sensor>)";
+const char *kLight = R"(<emitter type="constant"><rgb name="radiance" value="1"/></emitter>)";
+
+std::string scene_with(const std::string &body) {
+    return std::string("<scene version=\"3.0.0\">\n") + kCamera + "\n" + body + "\n</scene>\n";
+}
+
+// Loads xml and returns the error message; fails the test if it loads.
+std::string load_error(const std::string &xml, const std::string &file_name = "scene.xml") {
+    std::string path = write_temp_scene(xml, file_name);
+    try {
+        load_scene(path);
+    } catch (const std::exception &e) {
+        std::string msg = e.what();
+        EXPECT_NE(msg.find(file_name), std::string::npos) << "message does not name the file: " << msg;
+        return msg;
+    }
+    ADD_FAILURE() << "scene loaded but should not have:\n" << xml;
+    return "";
+}
+
+TEST(SceneErrors, MalformedXmlNamesFileAndLine) {
+    std::string msg = load_error("<scene version=\"3.0.0\">\n<shape type=\"sphere\">\n</scene>\n", "broken.xml");
+    EXPECT_NE(msg.find("broken.xml:"), std::string::npos) << msg;
+}
+
+TEST(SceneErrors, UnknownPluginsAreRejectedWithTheirLine) {
+    EXPECT_NE(load_error(scene_with(std::string(kLight) + "\n<shape type=\"teapot\"/>")).find(":4:"), std::string::npos);
+    EXPECT_NE(load_error(scene_with(std::string(kLight) + "\n<shape type=\"sphere\"><bsdf type=\"velvet\"/></shape>")).find("velvet"),
+              std::string::npos);
+    EXPECT_NE(load_error(scene_with("<emitter type=\"sunsky\"/>")).find("sunsky"), std::string::npos);
+    EXPECT_NE(load_error(scene_with(std::string(kLight) + "<shape type=\"sphere\"><bsdf type=\"diffuse\"><texture name=\"reflectance\" type=\"noise\"/></bsdf></shape>")).find("noise"),
+              std::string::npos);
+}
+
+TEST(SceneErrors, MissingMeshAndTextureNameThePath) {
+    std::string msg = load_error(scene_with(std::string(kLight) + R"(<shape type="obj"><string name="filename" value="nowhere/mesh.obj"/></shape>)"));
+    EXPECT_NE(msg.find("nowhere/mesh.obj"), std::string::npos) << msg;
+    msg = load_error(scene_with(std::string(kLight) + R"(<shape type="sphere"><bsdf type="diffuse">
+        <texture name="reflectance" type="bitmap"><string name="filename" value="missing_tex.png"/></texture></bsdf></shape>)"));
+    EXPECT_NE(msg.find("missing_tex.png"), std::string::npos) << msg;
+}
+
+TEST(SceneErrors, NanVerticesAreRejected) {
+    std::string path = write_temp_scene(scene_with(std::string(kLight) + R"(<shape type="obj"><string name="filename" value="bad.obj"/></shape>)"));
+    std::ofstream(std::filesystem::path(path).parent_path() / "bad.obj") << "v 0 0 0\nv 1 nan 0\nv 0 1 0\nf 1 2 3\n";
+    try {
+        load_scene(path);
+        FAIL() << "NaN vertex accepted";
+    } catch (const std::exception &e) {
+        EXPECT_NE(std::string(e.what()).find("bad.obj"), std::string::npos) << e.what();
+    }
+}
+
+TEST(SceneErrors, EmptySceneAndSceneWithoutLights) {
+    EXPECT_NE(load_error("<scene version=\"3.0.0\"/>").find("light"), std::string::npos);
+    EXPECT_NE(load_error(scene_with("<shape type=\"sphere\"/>")).find("no light"), std::string::npos);
+}
+
+TEST(SceneErrors, AbsurdResolutionIsRejected) {
+    std::string xml = std::string("<scene version=\"3.0.0\">") +
+                      R"(<sensor type="perspective"><film type="hdrfilm"><integer name="width" value="1000000"/><integer name="height" value="1000000"/></film></sensor>)" +
+                      kLight + "</scene>";
+    EXPECT_NE(load_error(xml).find("out of range"), std::string::npos);
+    xml = std::string("<scene version=\"3.0.0\">") +
+          R"(<sensor type="perspective"><film type="hdrfilm"><integer name="width" value="0"/></film></sensor>)" + kLight + "</scene>";
+    load_error(xml);
+}
+
+TEST(SceneErrors, BadParameterValues) {
+    load_error(scene_with(std::string(kLight) + R"(<shape type="sphere"><float name="radius" value="-1"/></shape>)"));
+    load_error(scene_with(std::string(kLight) + R"(<shape type="sphere"><float name="radius" value="abc"/></shape>)"));
+    load_error(scene_with(std::string(kLight) + R"(<shape type="sphere"><bsdf type="roughconductor"><string name="material" value="Unobtainium"/></bsdf></shape>)"));
+    load_error(scene_with(std::string(kLight) + R"(<shape type="sphere"><bsdf type="dielectric"><string name="int_ior" value="glassy"/></bsdf></shape>)"));
+    load_error(scene_with(std::string(kLight) + R"(<shape type="sphere"><ref id="nothing"/></shape>)"));
+}
+
+TEST(SceneErrors, UnknownIntegratorAndOptionsAreRejected) {
+    EXPECT_THROW(make_integrator("bidir-magic", Options()), std::invalid_argument);
+    EXPECT_THROW(make_integrator("path", Options(OptionMap{{"max_dpeth", "3"}})), std::invalid_argument);
+    EXPECT_THROW(make_integrator("path", Options(OptionMap{{"max_depth", "three"}})), std::invalid_argument);
+    EXPECT_THROW(make_integrator("path", Options(OptionMap{{"max_depth", "0"}})), std::invalid_argument);
+}
+
+TEST(SceneLoader, DemoSceneLoads) {
+    auto scene = load_scene(std::string(NEEPP_SOURCE_DIR) + "/scenes/door-ajar/scene.xml");
+    EXPECT_EQ(scene->lights().size(), 1u);
+    EXPECT_GT(scene->triangle_count(), 100u);
+    EXPECT_EQ(scene->camera.width, 480);
+    EXPECT_EQ(scene->settings.integrator, "path");
+    EXPECT_EQ(scene->settings.integrator_options.at("max_depth"), "12");
+    auto small = load_scene(std::string(NEEPP_SOURCE_DIR) + "/scenes/door-ajar/scene.xml", {{"resx", "64"}, {"resy", "32"}});
+    EXPECT_EQ(small->camera.width, 64);
+    EXPECT_EQ(small->camera.height, 32);
+}
+
+}  // namespace

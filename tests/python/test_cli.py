@@ -1,0 +1,111 @@
+"""The command-line tool as a user meets it: outputs, statistics, time limits, Ctrl-C and bad input."""
+from __future__ import annotations
+
+import json
+import signal
+import subprocess
+import time
+from pathlib import Path
+
+import pytest
+
+REPO = Path(__file__).resolve().parents[2]
+DEMO = REPO / "scenes" / "door-ajar" / "scene.xml"
+SMALL = ["-D", "resx=64", "-D", "resy=36"]
+
+
+def run(neepp_bin, *args, timeout=120):
+    return subprocess.run([str(neepp_bin), *map(str, args)], capture_output=True, text=True, timeout=timeout)
+
+
+def test_render_writes_exr_png_and_stats(neepp_bin, tmp_path):
+    out = tmp_path / "img.exr"
+    r = run(neepp_bin, "render", DEMO, "-o", out, "--spp", 4, "--stats", tmp_path / "s.json", "--quiet", *SMALL)
+    assert r.returncode == 0, r.stderr
+    assert out.stat().st_size > 0 and (tmp_path / "img.png").stat().st_size > 0
+    s = json.loads((tmp_path / "s.json").read_text())
+    for key in ["integrator", "spp", "width", "height", "render_time_s", "samples_per_s", "rays", "shadow_rays",
+                "occlusion_time_s", "peak_memory_mb"]:
+        assert key in s, key
+    assert s["spp"] == 4 and s["width"] == 64 and s["height"] == 36
+    assert s["integrator"]["name"] == "path" and s["integrator"]["max_depth"] == 12
+    assert s["rays"] >= 4 * 64 * 36 and s["shadow_rays"] > 0
+
+
+def test_same_seed_same_image_different_seed_different_image(neepp_bin, tmp_path):
+    def render(seed, name, threads):
+        r = run(neepp_bin, "render", DEMO, "-o", tmp_path / name, "--spp", 2, "--seed", seed, "--threads", threads,
+                "--quiet", *SMALL)
+        assert r.returncode == 0, r.stderr
+        return (tmp_path / name).read_bytes()
+    assert render(1, "a.exr", 1) == render(1, "b.exr", 2)
+    assert render(1, "a.exr", 2) != render(2, "c.exr", 2)
+
+
+def test_integrator_options_and_overrides(neepp_bin, tmp_path):
+    r = run(neepp_bin, "render", DEMO, "-o", tmp_path / "o.exr", "--spp", 1, "-I", "max_depth=3", "-I", "nee=false",
+            "--stats", tmp_path / "s.json", "--quiet", *SMALL)
+    assert r.returncode == 0, r.stderr
+    s = json.loads((tmp_path / "s.json").read_text())
+    assert s["integrator"]["max_depth"] == 3 and s["integrator"]["nee"] is False and s["shadow_rays"] == 0
+
+
+def test_time_limit_writes_the_image_reached(neepp_bin, tmp_path):
+    t0 = time.time()
+    r = run(neepp_bin, "render", DEMO, "-o", tmp_path / "t.exr", "--time", 1.5, "--stats", tmp_path / "s.json",
+            "--quiet", "-D", "resx=160", "-D", "resy=90")
+    assert r.returncode == 0, r.stderr
+    assert time.time() - t0 < 15
+    s = json.loads((tmp_path / "s.json").read_text())
+    assert s["spp"] >= 1 and s["stopped_by"] == "time" and s["render_time_s"] < 3.0
+    assert (tmp_path / "t.png").exists()
+
+
+def test_ctrl_c_stops_cleanly_and_writes_the_image(neepp_bin, tmp_path):
+    p = subprocess.Popen([str(neepp_bin), "render", str(DEMO), "-o", str(tmp_path / "c.exr"), "--spp", "100000",
+                          "--stats", str(tmp_path / "s.json"), "--quiet", "-D", "resx=160", "-D", "resy=90"],
+                         stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    time.sleep(2.0)
+    p.send_signal(signal.SIGINT)
+    _, err = p.communicate(timeout=60)
+    assert p.returncode == 130, err
+    s = json.loads((tmp_path / "s.json").read_text())
+    assert s["stopped_by"] == "cancel" and 1 <= s["spp"] < 100000
+    assert (tmp_path / "c.exr").stat().st_size > 0
+
+
+@pytest.mark.parametrize("xml, expect", [
+    ("<scene version='3.0.0'><shape type='sphere'>", "bad.xml"),
+    ("<scene version='3.0.0'><emitter type='constant'/><shape type='teapot'/></scene>", "teapot"),
+    ("<scene version='3.0.0'><emitter type='constant'/><shape type='obj'><string name='filename' value='gone.obj'/></shape></scene>", "gone.obj"),
+    ("<scene version='3.0.0'/>", "light"),
+    ("<scene version='3.0.0'><shape type='sphere'/></scene>", "no light"),
+    ("<scene version='3.0.0'><emitter type='constant'/><sensor type='perspective'><film type='hdrfilm'>"
+     "<integer name='width' value='99999999'/></film></sensor></scene>", "out of range"),
+    ("not xml at all", "bad.xml"),
+])
+def test_bad_scene_gives_a_clear_error(neepp_bin, tmp_path, xml, expect):
+    scene = tmp_path / "bad.xml"
+    scene.write_text(xml)
+    r = run(neepp_bin, "render", scene, "-o", tmp_path / "x.exr", "--spp", 1, timeout=30)
+    assert r.returncode == 1, (r.returncode, r.stderr)  # an error exit, not a signal (crash)
+    assert "error" in r.stderr and expect in r.stderr, r.stderr
+
+
+@pytest.mark.parametrize("args, expect", [
+    (["-I", "max_dpeth=3"], "max_dpeth"),
+    (["-I", "max_depth"], "name=value"),
+    (["--integrator", "warp-drive"], "warp-drive"),
+    (["-D", "resx=abc"], "abc"),
+    (["--sampler", "magic"], "magic"),
+])
+def test_bad_options_give_a_clear_error(neepp_bin, tmp_path, args, expect):
+    r = run(neepp_bin, "render", DEMO, "-o", tmp_path / "x.exr", "--spp", 1, *args, timeout=30)
+    assert r.returncode != 0 and r.returncode < 128, r.stderr
+    assert expect in r.stderr, r.stderr
+
+
+def test_demo_writes_its_outputs(neepp_bin, tmp_path):
+    r = run(neepp_bin, "demo", "-o", tmp_path / "demo", "--spp", 1, "--quiet", timeout=300)
+    assert r.returncode == 0, r.stderr
+    assert any(p.suffix == ".png" for p in (tmp_path / "demo").iterdir())
