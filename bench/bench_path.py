@@ -133,8 +133,9 @@ def main(argv=None) -> int:
         results["scenes"][scene] = {"width": w, "height": h, "runs": runs, "median": summ}
         n, m = summ.get("neepp", {}), summ.get("mitsuba", {})
         ratio = (n["samples_per_s"] / m["samples_per_s"]) if n.get("samples_per_s") and m.get("samples_per_s") else None
-        rows.append({"scene": f"{scene} {w}x{h}", "neepp_sps": n.get("samples_per_s"),
-                     "mi_sps": m.get("samples_per_s"), "ratio": ratio,
+        msps = lambda v: v / 1e6 if v else None  # noqa: E731
+        rows.append({"scene": f"{scene} {w}x{h}", "neepp_sps": msps(n.get("samples_per_s")),
+                     "mi_sps": msps(m.get("samples_per_s")), "ratio": ratio,
                      "neepp_relmse": n.get("relmse"), "mi_relmse": m.get("relmse"),
                      "neepp_mean": n.get("mean_ratio"), "mi_mean": m.get("mean_ratio"),
                      "neepp_mem": n.get("peak_memory_mb"), "mi_mem": m.get("peak_memory_mb")})
@@ -145,7 +146,7 @@ def main(argv=None) -> int:
                 report.error_map_png(out / f"{scene}_{k}_relmse.png", img, ref)
     results["loadavg_end"] = os.getloadavg()
 
-    headers = {"scene": "scene", "neepp_sps": "neepp samples/s", "mi_sps": f"Mitsuba {a.variant} samples/s",
+    headers = {"scene": "scene", "neepp_sps": "neepp M samples/s", "mi_sps": f"Mitsuba {a.variant} M samples/s",
                "ratio": "ratio neepp/Mitsuba", "neepp_relmse": "neepp relMSE", "mi_relmse": "Mitsuba relMSE",
                "neepp_mean": "neepp mean/ref", "mi_mean": "Mitsuba mean/ref",
                "neepp_mem": "neepp peak MB", "mi_mem": "Mitsuba peak MB"}

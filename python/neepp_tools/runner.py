@@ -8,6 +8,7 @@ JSON is killed.
 """
 from __future__ import annotations
 
+import functools
 import hashlib
 import json
 import os
@@ -15,6 +16,7 @@ import shutil
 import signal
 import subprocess
 import sys
+import tempfile
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -56,9 +58,6 @@ def _run_child(cmd, env=None, timeout=None, done_file: Path | None = None, grace
     (returncode then is 0 if done_file exists). On timeout the child is killed and RenderError raised.
     """
     t0 = time.perf_counter()
-    log_path = None
-    import tempfile
-
     with tempfile.TemporaryFile(mode="w+b") as logf:
         p = subprocess.Popen(cmd, env=env, cwd=cwd, stdout=logf, stderr=subprocess.STDOUT,
                              start_new_session=True)
@@ -110,13 +109,11 @@ def _kill(p):
 
 
 def find_neepp() -> Path | None:
-    """The neepp binary: $NEEPP_BIN, else <repo>/build/neepp. None if neither exists."""
+    """The neepp binary: $NEEPP_BIN if set (only it), else <repo>/build/neepp. None if it is not there."""
     env = os.environ.get("NEEPP_BIN")
-    cands = [Path(env)] if env else []
-    cands.append(REPO_ROOT / "build" / "neepp")
-    for c in cands:
-        if c.is_file() and os.access(c, os.X_OK):
-            return c
+    c = Path(env) if env else REPO_ROOT / "build" / "neepp"
+    if c.is_file() and os.access(c, os.X_OK):
+        return c.resolve()
     return None
 
 
@@ -204,11 +201,22 @@ def mitsuba_available(variant: str = "scalar_rgb") -> tuple[bool, str]:
     return True, r.stdout.strip()
 
 
+@functools.lru_cache(maxsize=None)
+def mitsuba_version() -> str:
+    """Version of mitsuba in mitsuba_python() ('' if not importable)."""
+    code = "import importlib.metadata as m, sys; sys.stdout.write(m.version('mitsuba'))"
+    try:
+        r = subprocess.run([mitsuba_python(), "-c", code], capture_output=True, text=True, timeout=60)
+    except (OSError, subprocess.TimeoutExpired):
+        return ""
+    return r.stdout.strip() if r.returncode == 0 else ""
+
+
 def _cache_key(scene, **kw) -> str:
     scene = Path(scene).resolve()
     st = scene.stat()
-    blob = json.dumps({"scene": str(scene), "size": st.st_size, "mtime": int(st.st_mtime), **kw},
-                      sort_keys=True)
+    blob = json.dumps({"scene": str(scene), "size": st.st_size, "mtime": int(st.st_mtime),
+                       "mitsuba": mitsuba_version(), **kw}, sort_keys=True)
     return hashlib.sha1(blob.encode()).hexdigest()[:16]
 
 

@@ -45,7 +45,7 @@ def mitsuba_variant() -> str:
     ok, why2 = runner.mitsuba_available("scalar_rgb")
     if ok:
         return "scalar_rgb"
-    pytest.skip(f"Mitsuba 3 not usable: {why2} (run scripts/setup_python.sh)")
+    pytest.skip(f"Mitsuba 3 not usable: {why2}")
 
 
 @pytest.fixture(scope="session")
