@@ -29,7 +29,7 @@ from pathlib import Path
 REPO = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(REPO / "python"))
 
-from neepp_tools import REFERENCES, SCENES_DIR, exr, metrics, report, runner  # noqa: E402
+from neepp_tools import REFERENCES, SCENES_DIR, credit, exr, metrics, report, runner  # noqa: E402
 
 
 def med(xs):
@@ -132,28 +132,37 @@ def main(argv=None) -> int:
                 summ[k]["samples_per_s_range"] = spread([x.get("samples_per_s") for x in rs])
         results["scenes"][scene] = {"width": w, "height": h, "runs": runs, "median": summ}
         n, m = summ.get("neepp", {}), summ.get("mitsuba", {})
-        ratio = (n["samples_per_s"] / m["samples_per_s"]) if n.get("samples_per_s") and m.get("samples_per_s") else None
+        # ratio per repetition (the two renders of a rep ran back to back), then the median
+        rep_ratios = [x["samples_per_s"] / y["samples_per_s"] for x, y in zip(runs["neepp"], runs["mitsuba"])
+                      if x.get("samples_per_s") and y.get("samples_per_s")]
+        ratio = med(rep_ratios)
+        summ["ratio_per_rep"] = rep_ratios
         msps = lambda v: v / 1e6 if v else None  # noqa: E731
         rows.append({"scene": f"{scene} {w}x{h}", "neepp_sps": msps(n.get("samples_per_s")),
                      "mi_sps": msps(m.get("samples_per_s")), "ratio": ratio,
+                     "ratio_range": (f"{min(rep_ratios):.3g}-{max(rep_ratios):.3g}" if len(rep_ratios) > 1 else None),
                      "neepp_relmse": n.get("relmse"), "mi_relmse": m.get("relmse"),
                      "neepp_mean": n.get("mean_ratio"), "mi_mean": m.get("mean_ratio"),
                      "neepp_mem": n.get("peak_memory_mb"), "mi_mem": m.get("peak_memory_mb")})
         if last_img:
             report.comparison_figure(out / f"{scene}_compare.png", last_img, ref,
-                                     title=f"{scene} {w}x{h}, {a.spp} spp, max_depth {a.max_depth}")
+                                     title=f"{scene} {w}x{h}, {a.spp} spp, max_depth {a.max_depth}",
+                                     credit=credit(scene))
             for k, img in last_img.items():
                 report.error_map_png(out / f"{scene}_{k}_relmse.png", img, ref)
     results["loadavg_end"] = os.getloadavg()
 
     headers = {"scene": "scene", "neepp_sps": "neepp M samples/s", "mi_sps": f"Mitsuba {a.variant} M samples/s",
-               "ratio": "ratio neepp/Mitsuba", "neepp_relmse": "neepp relMSE", "mi_relmse": "Mitsuba relMSE",
+               "ratio": "ratio neepp/Mitsuba", "ratio_range": "ratio range", "neepp_relmse": "neepp relMSE", "mi_relmse": "Mitsuba relMSE",
                "neepp_mean": "neepp mean/ref", "mi_mean": "Mitsuba mean/ref",
                "neepp_mem": "neepp peak MB", "mi_mem": "Mitsuba peak MB"}
     table = report.markdown_table(rows, list(headers), headers)
+    credits = "".join(f"\n- {scene}: {credit(scene)}" for scene in scenes if credit(scene))
+    if credits:
+        credits = "\nScene credits:" + credits + "\n"
     md = (f"path, max_depth {a.max_depth}, {a.spp} spp, median of {a.reps} rep(s), "
           f"{results['threads']} threads, load avg {results['loadavg_start'][0]:.2f} -> {results['loadavg_end'][0]:.2f}; "
-          f"relMSE against shared/scenes/<scene>/reference (Mitsuba 3.9.1 llvm_ad_rgb, 2272-6032 spp)\n\n{table}\n")
+          f"relMSE against shared/scenes/<scene>/reference (Mitsuba 3.9.1 llvm_ad_rgb, 2272-6032 spp)\n\n{table}\n{credits}")
     (out / "report.md").write_text(md)
     (out / "results.json").write_text(json.dumps(results, indent=2, default=float))
     print(md)

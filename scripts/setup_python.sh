@@ -20,11 +20,11 @@ REQS=(
 
 # libllvm19 for the llvm variant (LLVM 14/15 make Dr.Jit abort). Skip apt when present.
 if ! dpkg-query -W -f='${Status}' libllvm19 2>/dev/null | grep -q "install ok installed"; then
-  "$ROOT/scripts/install_deps.sh" libllvm19 || echo "setup_python: WARNING: could not install libllvm19; only scalar_rgb will work" >&2
+  bash "$ROOT/scripts/install_deps.sh" libllvm19 || echo "setup_python: WARNING: could not install libllvm19; only scalar_rgb will work" >&2
 fi
 # python3-venv is needed for `python3 -m venv` with Debian's python.
 if ! "$PYTHON" -c "import ensurepip, venv" 2>/dev/null; then
-  "$ROOT/scripts/install_deps.sh"
+  bash "$ROOT/scripts/install_deps.sh"
 fi
 
 if [ ! -x "$VENV/bin/python" ]; then

@@ -21,6 +21,20 @@ REFERENCES = {
 }
 
 
+#: Attribution required wherever the CC-BY 3.0 scenes are shown (shared/scenes/SOURCES.md).
+CREDITS = {
+    "classroom": '"Japanese Classroom" by NovaZeeke, CC-BY 3.0 (scene via Benedikt Bitterli\'s Rendering Resources)',
+    "staircase": '"The Wooden Staircase" by Wig42, CC-BY 3.0 (scene via Benedikt Bitterli\'s Rendering Resources)',
+    "living-room": '"The Grey & White Room" by Wig42, CC-BY 3.0 (scene via Benedikt Bitterli\'s Rendering Resources)',
+}
+CC_BY_URL = "https://creativecommons.org/licenses/by/3.0/"
+
+
+def credit(scene: str) -> str:
+    """Attribution line for a scene ('' for the CC0 ones)."""
+    return f"{CREDITS[scene]}, {CC_BY_URL}" if scene in CREDITS else ""
+
+
 def scene_xml(scene: str, scenes_dir: Path = SCENES_DIR) -> Path:
     return Path(scenes_dir) / scene / "scene.xml"
 

@@ -27,11 +27,13 @@ def save_png(path, img: np.ndarray, exposure: float = 1.0) -> None:
 
 
 def comparison_figure(path, images: dict, ref: np.ndarray | None = None, title: str = "",
-                      exposure: float | None = None, err_range: tuple = (1e-4, 1e1)) -> dict:
+                      exposure: float | None = None, err_range: tuple = (1e-4, 1e1),
+                      credit: str = "") -> dict:
     """Write a PNG: top row the images (and the reference), bottom row log-scale false-colour relMSE
     maps of each image against ref (same colour scale for all). Returns {name: relMSE}.
 
-    images: {label: (H, W, 3) array}; ref: the reference or None (then no error row).
+    images: {label: (H, W, 3) array}; ref: the reference or None (then no error row);
+    credit: attribution line printed under the figure (neepp_tools.credit(scene) for CC-BY scenes).
     """
     import matplotlib
 
@@ -78,6 +80,9 @@ def comparison_figure(path, images: dict, ref: np.ndarray | None = None, title: 
     if title:
         fig.suptitle(title, fontsize=11)
     fig.tight_layout()
+    if credit:
+        fig.subplots_adjust(bottom=max(fig.subplotpars.bottom, 0.06))
+        fig.text(0.5, 0.01, credit, ha="center", va="bottom", fontsize=7)
     Path(path).parent.mkdir(parents=True, exist_ok=True)
     fig.savefig(str(path), dpi=100)
     plt.close(fig)

@@ -30,8 +30,8 @@ Chi2Result chi2_from_histograms(const std::vector<double> &observed, const std::
 
 // Directions are binned over (phi, cos theta) around frame.n — an equal-area parameterization, so the
 // pdf integrates over each bin without a Jacobian — and the pdf is integrated per bin with Simpson's
-// rule. Restricting the bins to the cap cos theta >= cos_min resolves a distribution of small support
-// (a distant light); a sample outside the cap is an error.
+// rule. Restricting the bins to the band cos_min <= cos theta <= cos_max resolves a distribution of small
+// support (a distant light); a sample outside the band is an error.
 struct SphereChi2Config {
     int res = 101;                    // cos theta bins; phi gets twice as many
     int ires = 4;                     // Simpson subintervals per bin and dimension (even)
@@ -39,7 +39,7 @@ struct SphereChi2Config {
     uint64_t seed = 1;
     double min_expected = 5.0;        // bins expecting fewer samples are pooled
     Frame frame;                      // world directions are binned in this frame
-    double cos_min = -1.0;
+    double cos_min = -1.0, cos_max = 1.0;
 };
 
 // Draws one direction (world space, unit) from the random stream, or nothing for an invalid sample.

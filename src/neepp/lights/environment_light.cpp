@@ -13,7 +13,7 @@ EnvironmentMapLight::EnvironmentMapLight(Image image, const Transform &to_world,
     // directional pdf stays bounded near the poles. Each cell's weight uses the bilinear lookups' maximum
     // neighbourhood by averaging the cell corners, so no cell with radiance gets zero probability.
     std::vector<float> weights(size_t(w) * h);
-    double sum = 0;
+    bool any = false;
     for (int y = 0; y < h; ++y) {
         float sin_theta = std::sin(kPi * (float(y) + 0.5f) / float(h));
         for (int x = 0; x < w; ++x) {
@@ -24,11 +24,13 @@ EnvironmentMapLight::EnvironmentMapLight(Image image, const Transform &to_world,
                     lum = std::max(lum, luminance(lookup(uv)));
                 }
             weights[size_t(y) * w + x] = std::max(lum, 0.f) * sin_theta;
-            Color c = image_.rgb(x, y);
-            sum += double(luminance(c)) * sin_theta;
+            any |= weights[size_t(y) * w + x] > 0;
         }
     }
-    distribution_ = Distribution2D(weights, w, h);
+    if (!any)  // a black map emits nothing, but sampling it must still be well defined
+        for (int y = 0; y < h; ++y)
+            for (int x = 0; x < w; ++x) weights[size_t(y) * w + x] = std::sin(kPi * (float(y) + 0.5f) / float(h));
+    cells_ = AliasTable(weights);
     // Mean radiance over the sphere (for power): integrate with the sin(theta) measure.
     Color acc(0.f);
     double norm_w = 0;
@@ -38,7 +40,6 @@ EnvironmentMapLight::EnvironmentMapLight(Image image, const Transform &to_world,
         norm_w += double(sin_theta) * w;
     }
     mean_radiance_ = acc * float(scale_ / norm_w);
-    (void)sum;
 }
 
 Vec2 EnvironmentMapLight::direction_to_uv(const Vec3 &d_world) const {
@@ -73,8 +74,11 @@ Color EnvironmentMapLight::lookup(Vec2 uv) const {
 Color EnvironmentMapLight::eval_environment(const Vec3 &d) const { return lookup(direction_to_uv(d)) * scale_; }
 
 DirectionSample EnvironmentMapLight::sample_direction(const Vec3 &ref, Vec2 u, Color &radiance) const {
-    float pdf_uv;
-    Vec2 uv = distribution_.sample(u, &pdf_uv);
+    Vec2 offset;
+    uint32_t cell = cells_.sample(u, offset);
+    int w = image_.width, h = image_.height;
+    Vec2 uv((float(cell % w) + offset.x) / float(w), (float(cell / w) + offset.y) / float(h));
+    float pdf_uv = cells_.pmf(cell) * float(w) * float(h);
     DirectionSample ds;
     radiance = Color(0.f);
     float sin_theta = std::sin(uv.y * kPi);
@@ -91,7 +95,9 @@ float EnvironmentMapLight::pdf_direction(const Vec3 &, const DirectionSample &ds
     Vec2 uv = direction_to_uv(ds.d);
     float sin_theta = std::sin(uv.y * kPi);
     if (sin_theta <= 0) return 0.f;
-    return distribution_.pdf(uv) / (2.f * kPi * kPi * sin_theta);
+    int w = image_.width, h = image_.height;
+    int x = std::min(int(uv.x * float(w)), w - 1), y = std::min(int(uv.y * float(h)), h - 1);
+    return cells_.pmf(uint32_t(y) * w + x) * float(w) * float(h) / (2.f * kPi * kPi * sin_theta);
 }
 
 Color EnvironmentMapLight::power() const {

@@ -28,7 +28,7 @@ private:
     Image image_;
     Transform to_world_;
     float scale_;
-    Distribution2D distribution_;
+    AliasTable cells_;  // one entry per texel cell, ∝ luminance × sin(theta)
     Color mean_radiance_;
     float scene_radius_ = 1.f;
 };

@@ -79,3 +79,57 @@ float Distribution2D::pdf(Vec2 p) const {
 }
 
 }  // namespace neepp
+
+namespace neepp {
+
+AliasTable::AliasTable(const std::vector<float> &weights) {
+    size_t n = weights.size();
+    bins_.resize(n);
+    double sum = 0;
+    for (float w : weights) sum += (w > 0 && std::isfinite(w)) ? w : 0.f;
+    total_ = float(sum);
+    if (n == 0) return;
+    if (!(sum > 0)) throw std::invalid_argument("AliasTable: all weights are zero");
+    // Vose's method: scaled probabilities p_i * n split into a "small" (< 1) and a "large" worklist.
+    std::vector<double> scaled(n);
+    std::vector<uint32_t> small, large;
+    for (size_t i = 0; i < n; ++i) {
+        double w = (weights[i] > 0 && std::isfinite(weights[i])) ? weights[i] : 0.0;
+        bins_[i].pmf = float(w / sum);
+        scaled[i] = w / sum * double(n);
+        (scaled[i] < 1.0 ? small : large).push_back(uint32_t(i));
+    }
+    while (!small.empty() && !large.empty()) {
+        uint32_t s = small.back(), l = large.back();
+        small.pop_back();
+        bins_[s].threshold = float(scaled[s]);
+        bins_[s].alias = l;
+        scaled[l] -= 1.0 - scaled[s];
+        if (scaled[l] < 1.0) { large.pop_back(); small.push_back(l); }
+    }
+    // Leftovers are 1 up to rounding: they keep themselves.
+    for (uint32_t i : large) { bins_[i].threshold = 1.f; bins_[i].alias = i; }
+    for (uint32_t i : small) { bins_[i].threshold = 1.f; bins_[i].alias = i; }
+}
+
+uint32_t AliasTable::sample(Vec2 u, Vec2 &offset) const {
+    // 48 random bits: the 24 mantissa bits of each sampler dimension.
+    uint64_t bits = (uint64_t(double(u.x) * 0x1p24) << 24) | uint64_t(double(u.y) * 0x1p24);
+    unsigned __int128 scaled = (unsigned __int128)bits * bins_.size();
+    uint32_t i = uint32_t(scaled >> 48);
+    double frac = double(uint64_t(scaled) & ((uint64_t(1) << 48) - 1)) * 0x1p-48;
+    const Bin &b = bins_[i];
+    double rest;
+    if (frac < b.threshold) {
+        rest = frac / b.threshold;
+    } else {
+        rest = (frac - b.threshold) / (1.0 - b.threshold);
+        i = b.alias;
+    }
+    // Split the leftover variate into two: its coarse part and its fine part scaled back up.
+    double fine = rest * 4096.0;
+    offset = Vec2(float(std::min(rest, 0.99999994)), float(std::min(fine - std::floor(fine), 0.99999994)));
+    return i;
+}
+
+}  // namespace neepp

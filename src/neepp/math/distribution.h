@@ -45,3 +45,32 @@ private:
 };
 
 }  // namespace neepp
+
+namespace neepp {
+
+// Walker/Vose alias table: O(1) discrete sampling with two memory reads, for large distributions
+// (environment maps with millions of cells) where a binary search's cache misses dominate.
+class AliasTable {
+public:
+    AliasTable() = default;
+    explicit AliasTable(const std::vector<float> &weights);
+    size_t size() const { return bins_.size(); }
+    float total() const { return total_; }
+    // Returns an index with probability weight[i] / total. Both 24-bit variates of u are spent on the
+    // choice (a single float has too few bits to pick among millions of bins without bias); what is
+    // left over comes back in `offset` as a point uniform in [0,1)^2 to ~12 bits per axis, enough to
+    // place a sample inside the chosen cell.
+    uint32_t sample(Vec2 u, Vec2 &offset) const;
+    float pmf(uint32_t i) const { return bins_[i].pmf; }
+
+private:
+    struct Bin {
+        float threshold;  // probability of keeping this bin rather than jumping to its alias
+        uint32_t alias;
+        float pmf;        // weight / total, stored beside the rest so sampling touches one cache line
+    };
+    std::vector<Bin> bins_;
+    float total_ = 0;
+};
+
+}  // namespace neepp
