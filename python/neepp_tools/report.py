@@ -46,7 +46,7 @@ def comparison_figure(path, images: dict, ref: np.ndarray | None = None, title: 
     nrows = 2 if ref is not None else 1
     h, w = next(iter(images.values())).shape[:2]
     cw = 4.0
-    fig, axes = plt.subplots(nrows, ncols, figsize=(cw * ncols, cw * h / w * nrows + 0.8 * nrows),
+    fig, axes = plt.subplots(nrows, ncols, figsize=(cw * ncols, cw * h / w * nrows + 1.0 * nrows + 0.5),
                              squeeze=False)
     if exposure is None:
         exposure = auto_exposure(ref if ref is not None else images[names[0]])
@@ -79,10 +79,12 @@ def comparison_figure(path, images: dict, ref: np.ndarray | None = None, title: 
             fig.colorbar(im, ax=axes[1][ncols - 1], fraction=0.9, label="relMSE (log)")
     if title:
         fig.suptitle(title, fontsize=11)
-    fig.tight_layout()
+    fig_h = fig.get_size_inches()[1]
+    top = 1 - (0.45 / fig_h if title else 0)
+    bottom = 0.3 / fig_h if credit else 0
+    fig.tight_layout(rect=(0, bottom, 1, top))
     if credit:
-        fig.subplots_adjust(bottom=max(fig.subplotpars.bottom, 0.06))
-        fig.text(0.5, 0.01, credit, ha="center", va="bottom", fontsize=7)
+        fig.text(0.5, 0.05 / fig_h, credit, ha="center", va="bottom", fontsize=7)
     Path(path).parent.mkdir(parents=True, exist_ok=True)
     fig.savefig(str(path), dpi=100)
     plt.close(fig)

@@ -4,6 +4,8 @@
 // quantities that next event estimation and BSDF sampling must agree on for MIS.
 #include <gtest/gtest.h>
 
+#include <sstream>
+
 #include "common/chi2.h"
 #include "neepp/lights/area_light.h"
 #include "neepp/lights/environment_light.h"
@@ -76,7 +78,9 @@ bool near_rel(const Color &a, const Color &b, float rel, float abs = 0.f) {
 }
 
 std::string str(const Vec3 &v) {
-    return "(" + std::to_string(v.x) + "," + std::to_string(v.y) + "," + std::to_string(v.z) + ")";
+    std::ostringstream os;
+    os << "(" << v.x << "," << v.y << "," << v.z << ")";
+    return os.str();
 }
 
 // Each sample's pdf and radiance must be those that tracing its direction reproduces. Round-off moves a

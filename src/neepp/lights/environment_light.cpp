@@ -46,7 +46,8 @@ Vec2 EnvironmentMapLight::direction_to_uv(const Vec3 &d_world) const {
     Vec3 v = normalize(to_world_.inverse().vector(d_world));
     float u = std::atan2(v.x, -v.z) * kInv2Pi;
     if (u < 0) u += 1.f;
-    float vv = std::acos(std::clamp(v.y, -1.f, 1.f)) * kInvPi;
+    // atan2 keeps precision near the poles, where acos(y) loses it.
+    float vv = std::atan2(std::sqrt(v.x * v.x + v.z * v.z), v.y) * kInvPi;
     return {u, vv};
 }
 

@@ -1,5 +1,7 @@
 // Mitsuba 3's `bitmap` texture: an image looked up by uv with bilinear or nearest filtering.
 #pragma once
+#include <array>
+#include <cstdint>
 #include <memory>
 #include <string>
 #include <string_view>
@@ -74,7 +76,9 @@ private:
     Color interpolate(Vec2 uv) const;
 
     int width_ = 0, height_ = 0, channels_ = 3;
-    std::vector<float> texels_;  // linear (unless raw), row-major, top row first
+    std::vector<float> texels_;     // float data (HDR images), or empty when codes_ is used
+    std::vector<uint8_t> codes_;    // 8-bit data, decoded through lut_
+    std::array<float, 256> lut_{};  // linear (unless raw), row-major, top row first
     BitmapOptions options_;
     UvTransform to_uv_;
     float mean_ = 0;

@@ -47,7 +47,9 @@ PositionSample Shape::sample_position(Vec2 u) const {
     const Vec3 &p0 = positions[i0], &p1 = positions[i1], &p2 = positions[i2];
     ps.p = p0 * (1.f - b.x - b.y) + p1 * b.x + p2 * b.y;
     ps.n = normalize(cross(p1 - p0, p2 - p0));
-    if (!uvs.empty()) ps.uv = uvs[i0] * (1.f - b.x - b.y) + uvs[i1] * b.x + uvs[i2] * b.y;
+    // Same uv as a ray hit at this point gets (barycentrics without texture coordinates), so textured
+    // emission agrees between light sampling and BSDF sampling.
+    ps.uv = uvs.empty() ? b : uvs[i0] * (1.f - b.x - b.y) + uvs[i1] * b.x + uvs[i2] * b.y;
     if (flip_normals) ps.n = -ps.n;
     return ps;
 }
