@@ -32,7 +32,7 @@ std::pair<std::string, std::string> split_key_value(const std::string &s, const 
 }
 
 struct RenderArgs {
-    std::string scene, output = "render.exr", integrator, stats, sampler;
+    std::string scene, output = "render.exr", integrator, stats, sampler, rfilter;
     int spp = 0, threads = 0;
     double time_s = 0;
     uint64_t seed = 0;
@@ -46,6 +46,10 @@ nlohmann::json run_render(const RenderArgs &a) {
     for (auto &d : a.defines) defines.insert(split_key_value(d, "-D"));
     if (a.spp > 0 && !defines.count("spp")) defines["spp"] = std::to_string(a.spp);
     auto scene = neepp::load_scene(a.scene, defines);
+    if (!a.rfilter.empty()) {  // e.g. box, so a low-resolution render matches a box-downsampled reference
+        scene->settings.rfilter = a.rfilter;
+        scene->settings.rfilter_radius = a.rfilter == "box" ? 0.5f : a.rfilter == "tent" ? 1.f : 4.f * scene->settings.rfilter_stddev;
+    }
 
     neepp::Options options(scene->settings.integrator_options);
     for (auto &o : a.integrator_options) {
@@ -96,6 +100,8 @@ int main(int argc, char **argv) {
     render->add_option("--integrator", ra.integrator, "Integrator (default: the scene's)");
     render->add_option("-I", ra.integrator_options, "Integrator option key=value");
     render->add_option("--sampler", ra.sampler, "Sampler: independent or sobol (default: the scene's)");
+    render->add_option("--rfilter", ra.rfilter, "Override the film's reconstruction filter")
+        ->check(CLI::IsMember({"box", "tent", "gaussian"}));
     render->add_option("--stats", ra.stats, "Write statistics JSON here");
     render->add_flag("-q,--quiet", ra.quiet, "No progress bar or messages");
 

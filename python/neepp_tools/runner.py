@@ -121,7 +121,8 @@ def run_neepp(scene, out_exr, *, spp: int | None = None, time_s: float | None = 
               resx: int | None = None, resy: int | None = None, max_depth: int | None = None,
               seed: int | None = 0, threads: int | None = None, integrator: str | None = None,
               integrator_args: dict | None = None, defines: dict | None = None,
-              binary=None, timeout: float | None = None, quiet: bool = True) -> RenderResult:
+              binary=None, timeout: float | None = None, quiet: bool = True,
+              extra_args: list | None = None) -> RenderResult:
     """Render scene with ``neepp render`` and read back OUT.exr and the stats JSON."""
     binary = Path(binary) if binary else find_neepp()
     if binary is None:
@@ -158,6 +159,7 @@ def run_neepp(scene, out_exr, *, spp: int | None = None, time_s: float | None = 
         cmd += ["-I", f"{k}={v}"]
     if quiet:
         cmd.append("--quiet")
+    cmd += [str(x) for x in (extra_args or [])]
     rc, out, wall, rss = _run_child(cmd, timeout=timeout)
     if rc != 0 or not out_exr.exists():
         raise RenderError(f"neepp failed (rc={rc}): {' '.join(cmd)}\n{out[-4000:]}")

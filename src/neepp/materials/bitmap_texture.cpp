@@ -37,6 +37,7 @@ namespace {
 // Dr.Jit's integer wrap (texture_impl.h tex_wrap), including its Euclidean modulo and mirror parity rule.
 int wrap(int pos, int res, WrapMode mode) {
     if (mode == WrapMode::Clamp) return std::clamp(pos, 0, res - 1);
+    if (unsigned(pos) < unsigned(res)) return pos;  // inside: every mode is the identity (no division)
     const int div = (pos < 0 ? pos + 1 : pos) / res;
     int mod = pos - div * res;
     if (mod < 0) mod += res;

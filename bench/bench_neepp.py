@@ -1,0 +1,131 @@
+#!/usr/bin/env python3
+"""Reproduce the NEE++ paper's tables: `nee` against each NEE++ shadow-ray policy of the path integrator.
+
+For every scene, at each sample count (default 4, 64, 1024) every policy renders the same scene with the
+same seed; the tables give, with ratios to `nee`: relMSE against the reference, shadow rays traced,
+time inside occlusion queries (visibility-test time) and total render time. An equal-time block then
+gives each policy the wall time `nee` needed at the middle sample count and compares relMSE. For `nee`
+the unoccluded fraction of its shadow rays (the oracle's best possible ratio) is reported too.
+
+Resolution: the reference's divided by --scale (default 4, e.g. 160x90 for classroom), rendered with a
+box filter and compared against the Mitsuba 3 reference box-downsampled by the same factor, so the
+footprints agree. The reference's own noise is a floor under every relMSE and pulls ratios toward 1 at
+high spp (EVALUATION.md): the tables state the reference used.
+
+    .venv/bin/python bench/bench_neepp.py                                  # six scenes, 4/64/1024 spp
+    .venv/bin/python bench/bench_neepp.py --scenes veach-ajar --spp 4,64   # quicker
+
+Writes bench/out/neepp/ (git-ignored): report.md, results.json, per-scene images and error maps.
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+from pathlib import Path
+
+import numpy as np
+
+REPO = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(REPO / "python"))
+
+from neepp_tools import REFERENCES, SCENES_DIR, credit, exr, metrics, report, runner  # noqa: E402
+
+POLICIES = ["nee", "neepp", "neepp-adaptive", "neepp-cv"]
+
+
+def downsample(img: np.ndarray, f: int) -> np.ndarray:
+    h, w = img.shape[0] // f, img.shape[1] // f
+    return img[: h * f, : w * f].reshape(h, f, w, f, 3).mean(axis=(1, 3))
+
+
+def render(scene_xml, out, policy, *, spp=None, time_s=None, w, h, max_depth, seed, threads, options):
+    args = {"shadow_rays": policy, **options} if policy != "nee" else dict(options)
+    return runner.run_neepp(scene_xml, out, spp=spp, time_s=time_s, resx=w, resy=h, max_depth=max_depth,
+                            seed=seed, threads=threads, integrator_args=args, extra_args=["--rfilter", "box"],
+                            timeout=7200)
+
+
+def row_for(policy, r, ref, base):
+    s = r.stats
+    rel = metrics.relmse(r.image, ref)
+    row = {"policy": policy, "spp": s["spp"], "relMSE": rel, "shadow_rays": s["shadow_rays"],
+           "occlusion_s": s["occlusion_time_s"], "render_s": s["render_time_s"]}
+    if base is not None:
+        row["relMSE ratio"] = rel / base["relMSE"]
+        row["shadow ray ratio"] = s["shadow_rays"] / max(1, base["shadow_rays"])
+        row["occlusion time ratio"] = s["occlusion_time_s"] / max(1e-12, base["occlusion_s"])
+        row["time ratio"] = s["render_time_s"] / max(1e-12, base["render_s"])
+    else:
+        traced = max(1, s["shadow_rays"])
+        row["unoccluded fraction"] = 1 - s.get("shadow_rays_occluded", 0) / traced
+    return row
+
+
+def table(rows) -> str:
+    columns = list(dict.fromkeys(k for r in rows for k in r))  # union of keys, first-seen order
+    return report.markdown_table(rows, columns)
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--scenes", default=",".join(REFERENCES))
+    ap.add_argument("--spp", default="4,64,1024", help="comma-separated sample counts")
+    ap.add_argument("--policies", default=",".join(POLICIES))
+    ap.add_argument("--scale", type=int, default=4, help="divide the reference resolution by this")
+    ap.add_argument("--max-depth", type=int, default=17)
+    ap.add_argument("--threads", type=int, default=0)
+    ap.add_argument("--seed", type=int, default=1)
+    ap.add_argument("-I", dest="options", action="append", default=[], help="extra integrator option k=v")
+    ap.add_argument("--scenes-dir", default=str(SCENES_DIR))
+    ap.add_argument("--out", default=str(REPO / "bench" / "out" / "neepp"))
+    a = ap.parse_args(argv)
+    options = dict(o.split("=", 1) for o in a.options)
+    spps = [int(x) for x in a.spp.split(",")]
+    policies = a.policies.split(",")
+    out = Path(a.out)
+    out.mkdir(parents=True, exist_ok=True)
+    results, md = {}, ["# NEE++ vs NEE (path integrator, max_depth %d)\n" % a.max_depth]
+    for scene in a.scenes.split(","):
+        W, H, _, ref_name = REFERENCES[scene]
+        w, h = W // a.scale, H // a.scale
+        xml = Path(a.scenes_dir) / scene / "scene.xml"
+        ref = downsample(exr.read_exr(Path(a.scenes_dir) / scene / "reference" / ref_name), a.scale)
+        md.append(f"\n## {scene} ({w}x{h}, box filter; reference: Mitsuba 3 {ref_name} box-downsampled ×{a.scale})\n")
+        if credit(scene):
+            md.append(f"_{credit(scene)}_\n")
+        results[scene] = {"equal_spp": {}, "equal_time": {}}
+        for spp in spps:
+            rows, base, images = [], None, {}
+            for policy in policies:
+                r = render(xml, out / scene / f"{policy}_{spp}spp.exr", policy, spp=spp, w=w, h=h,
+                           max_depth=a.max_depth, seed=a.seed, threads=a.threads, options=options)
+                row = row_for(policy, r, ref, base)
+                base = base or row
+                rows.append(row)
+                images[policy] = r.image
+                print(json.dumps(row), flush=True)
+            results[scene]["equal_spp"][spp] = rows
+            md.append(f"\n### equal spp: {spp}\n\n" + table(rows) + "\n")
+            report.comparison_figure(out / scene / f"compare_{spp}spp.png", images, ref=ref,
+                                     title=f"{scene}: {spp} spp", credit=credit(scene))
+        # Equal time: every policy gets the wall time `nee` used at the middle sample count.
+        mid = spps[len(spps) // 2]
+        budget = next(r for r in results[scene]["equal_spp"][mid] if r["policy"] == "nee")["render_s"]
+        rows, base = [], None
+        for policy in policies:
+            r = render(xml, out / scene / f"{policy}_equal_time.exr", policy, time_s=budget, w=w, h=h,
+                       max_depth=a.max_depth, seed=a.seed, threads=a.threads, options=options)
+            row = row_for(policy, r, ref, base)
+            base = base or row
+            rows.append(row)
+        results[scene]["equal_time"] = {"budget_s": budget, "rows": rows}
+        md.append(f"\n### equal time: {budget:.2f} s (nee's time at {mid} spp)\n\n" + table(rows) + "\n")
+        (out / "results.json").write_text(json.dumps(results, indent=2))
+        (out / "report.md").write_text("".join(md))
+    print("".join(md))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
