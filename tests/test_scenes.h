@@ -29,7 +29,7 @@ struct RenderedImage {
 };
 
 inline RenderedImage render_scene_file(const std::string &path, int spp, uint64_t seed, const Options &options,
-                                       const std::string &integrator = "path") {
+                                       const std::string &integrator = "path", const std::string &sampler = "independent") {
     auto scene = load_scene(path);
     Options o = options;
     for (auto &[k, v] : scene->settings.integrator_options)
@@ -38,6 +38,7 @@ inline RenderedImage render_scene_file(const std::string &path, int spp, uint64_
     RenderJob job;
     job.spp = spp;
     job.seed = seed;
+    job.sampler = sampler;
     RenderResult r = render(*scene, *integ, job);
     return {r.image, r};
 }

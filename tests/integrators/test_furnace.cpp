@@ -38,6 +38,7 @@ double expected_furnace(float rho, float le, int max_depth) {
 struct FurnaceCase {
     std::string name;
     std::map<std::string, std::string> options;
+    std::string sampler = "independent";
 };
 
 void PrintTo(const FurnaceCase &c, std::ostream *os) { *os << c.name; }
@@ -48,7 +49,7 @@ TEST_P(Furnace, InnerSphereMatchesGeometricSeries) {
     const float rho = 0.7f, le = 0.5f;
     for (int max_depth : {1, 2, 3, 8, -1}) {
         std::string path = write_temp_scene(inner_furnace_xml(rho, le, max_depth));
-        auto out = render_scene_file(path, 64, 7, Options(GetParam().options));
+        auto out = render_scene_file(path, 64, 7, Options(GetParam().options), "path", GetParam().sampler);
         double expected = expected_furnace(rho, le, max_depth);
         auto st = pixel_statistics(out.image, 1);
         // max_depth 1 and 2 are deterministic up to float rounding; deeper paths are noisy.
@@ -61,7 +62,8 @@ INSTANTIATE_TEST_SUITE_P(PathModes, Furnace,
                          ::testing::Values(FurnaceCase{"nee_power", {{"light_sampler", "power"}}},
                                            FurnaceCase{"nee_uniform", {{"light_sampler", "uniform"}}},
                                            FurnaceCase{"bsdf_only", {{"nee", "false"}}},
-                                           FurnaceCase{"rr_early", {{"rr_depth", "1"}}}),
+                                           FurnaceCase{"rr_early", {{"rr_depth", "1"}}},
+                                           FurnaceCase{"sobol_sampler", {}, "sobol"}),
                          [](const auto &info) { return info.param.name; });
 
 // A convex diffuse object under a constant environment of radiance 1 reflects exactly its albedo.
