@@ -32,7 +32,7 @@ std::pair<std::string, std::string> split_key_value(const std::string &s, const 
 }
 
 struct RenderArgs {
-    std::string scene, output = "render.exr", integrator, stats, sampler, rfilter;
+    std::string scene, output = "render.exr", integrator, stats, sampler, rfilter, visibility_map;
     int spp = 0, threads = 0;
     double time_s = 0;
     uint64_t seed = 0;
@@ -40,8 +40,13 @@ struct RenderArgs {
     bool quiet = false;
 };
 
-// Loads, renders and writes one image; returns the statistics.
-nlohmann::json run_render(const RenderArgs &a) {
+struct Rendered {
+    neepp::Image image;
+    nlohmann::json stats;
+};
+
+// Loads, renders and writes one image; returns it with its statistics.
+Rendered run_render(const RenderArgs &a) {
     std::map<std::string, std::string> defines;
     for (auto &d : a.defines) defines.insert(split_key_value(d, "-D"));
     if (a.spp > 0 && !defines.count("spp")) defines["spp"] = std::to_string(a.spp);
@@ -52,6 +57,7 @@ nlohmann::json run_render(const RenderArgs &a) {
     }
 
     neepp::Options options(scene->settings.integrator_options);
+    if (!a.visibility_map.empty()) options.set("visibility_map", a.visibility_map);
     for (auto &o : a.integrator_options) {
         auto [k, v] = split_key_value(o, "-I");
         options.set(k, v);
@@ -79,7 +85,61 @@ nlohmann::json run_render(const RenderArgs &a) {
     if (!a.quiet)
         fmt::print(stderr, "neepp: {} spp in {:.2f} s ({:.3f} M samples/s, stopped by {}), wrote {} and {}\n", result.spp,
                    result.render_time_s, stats["samples_per_s"].get<double>() * 1e-6, result.stopped_by, a.output, png);
-    return stats;
+    return {std::move(result.image), std::move(stats)};
+}
+
+// The two images next to each other with a thin black gap, for a person to compare at a glance.
+neepp::Image side_by_side(const neepp::Image &left, const neepp::Image &right) {
+    const int gap = 8;
+    neepp::Image out(left.width + gap + right.width, std::max(left.height, right.height), 3);
+    auto blit = [&](const neepp::Image &img, int x0) {
+        for (int y = 0; y < img.height; ++y)
+            for (int x = 0; x < img.width; ++x)
+                for (int c = 0; c < 3; ++c) out.at(x0 + x, y, c) = img.at(x, y, std::min(c, img.channels - 1));
+    };
+    blit(left, 0);
+    blit(right, left.width + gap);
+    return out;
+}
+
+// The demo: the built-in door-ajar scene with plain NEE, then with NEE++ for the same wall time, so a
+// first-time user sees what NEE++ buys (more samples per pixel, less noise, in equal time).
+void run_demo(const std::string &dir, int spp, bool quiet) {
+    std::filesystem::create_directories(dir);
+    RenderArgs nee;
+    nee.scene = std::string(NEEPP_SCENES_DIR) + "/door-ajar/scene.xml";
+    nee.output = dir + "/demo_nee.exr";
+    nee.stats = dir + "/demo_nee.json";
+    nee.spp = spp;
+    nee.quiet = quiet;
+    nee.integrator_options = {"shadow_rays=nee"};
+    Rendered a = run_render(nee);
+
+    RenderArgs pp = nee;
+    pp.output = dir + "/demo_neepp.exr";
+    pp.stats = dir + "/demo_neepp.json";
+    pp.spp = 0;
+    pp.time_s = a.stats["render_time_s"].get<double>();
+    pp.integrator_options = {"shadow_rays=neepp-adaptive"};  // the best policy measured (see the closing notes)
+    Rendered b = run_render(pp);
+
+    neepp::write_png_srgb(dir + "/demo_side_by_side.png", side_by_side(a.image, b.image));
+    auto ratio = [&](const char *k) {
+        double d = a.stats[k].get<double>();
+        return d > 0 ? b.stats[k].get<double>() / d : 0.0;
+    };
+    nlohmann::json summary = {{"equal_time_s", pp.time_s},
+                              {"nee", a.stats},
+                              {"neepp", b.stats},
+                              {"spp_ratio_neepp_over_nee", ratio("spp")},
+                              {"shadow_rays_per_sample_ratio", ratio("shadow_rays") / std::max(1e-12, ratio("spp"))}};
+    std::ofstream(dir + "/demo_summary.json") << summary.dump(2) << "\n";
+    if (!quiet)
+        fmt::print(stderr,
+                   "neepp demo: in {:.2f} s, NEE reached {} spp and NEE++ {} spp ({:.2f}x), with {:.2f}x the shadow rays per "
+                   "sample; see {}/demo_side_by_side.png (left NEE, right NEE++)\n",
+                   pp.time_s, a.stats["spp"].get<int>(), b.stats["spp"].get<int>(), ratio("spp"),
+                   summary["shadow_rays_per_sample_ratio"].get<double>(), dir);
 }
 
 }  // namespace
@@ -102,13 +162,16 @@ int main(int argc, char **argv) {
     render->add_option("--sampler", ra.sampler, "Sampler: independent or sobol (default: the scene's)");
     render->add_option("--rfilter", ra.rfilter, "Override the film's reconstruction filter")
         ->check(CLI::IsMember({"box", "tent", "gaussian"}));
+    render->add_option("--visibility-map", ra.visibility_map,
+                       "NEE++ visibility map file: loaded if it exists and belongs to this scene, else built and saved");
     render->add_option("--stats", ra.stats, "Write statistics JSON here");
     render->add_flag("-q,--quiet", ra.quiet, "No progress bar or messages");
 
     std::string demo_dir = "neepp-demo";
     int demo_spp = 64;
     bool demo_quiet = false;
-    auto *demo = app.add_subcommand("demo", "Render the built-in demo scene (a room lit through a door ajar)");
+    auto *demo = app.add_subcommand("demo", "Render the built-in demo scene (a room lit through a door ajar) with NEE "
+                                            "and with NEE++ at equal time");
     demo->add_option("-o,--output-dir", demo_dir, "Directory for the demo's images and statistics");
     demo->add_option("--spp", demo_spp, "Samples per pixel")->check(CLI::Range(1, 1 << 20));
     demo->add_flag("-q,--quiet", demo_quiet, "No progress bar or messages");
@@ -119,14 +182,7 @@ int main(int argc, char **argv) {
         if (*render) {
             run_render(ra);
         } else if (*demo) {
-            std::filesystem::create_directories(demo_dir);
-            RenderArgs d;
-            d.scene = std::string(NEEPP_SCENES_DIR) + "/door-ajar/scene.xml";
-            d.output = demo_dir + "/demo_nee.exr";
-            d.stats = demo_dir + "/demo_nee.json";
-            d.spp = demo_spp;
-            d.quiet = demo_quiet;
-            run_render(d);
+            run_demo(demo_dir, demo_spp, demo_quiet);
         }
     } catch (const std::exception &e) {
         fmt::print(stderr, "neepp: error: {}\n", e.what());

@@ -1,5 +1,6 @@
 #include <stdexcept>
 #include "neepp/integrators/path.h"
+#include "neepp/visibility/neepp_shadow_rays.h"
 
 namespace neepp {
 
@@ -14,9 +15,24 @@ std::unique_ptr<Integrator> make_integrator(const std::string &name, const Optio
         o.light_sampler = options.get_string("light_sampler", o.light_sampler);
         if (o.max_depth < -1 || o.max_depth == 0) throw std::invalid_argument("max_depth must be -1 or >= 1");
         if (o.rr_depth < 1) throw std::invalid_argument("rr_depth must be >= 1");
+        // Shadow-ray policy: nee traces every shadow ray; the neepp* policies (NEE++) play Russian roulette
+        // driven by a visibility map. Their options are only accepted with them, so a typo'd or
+        // meaningless option is still reported as unused.
         std::string policy = options.get_string("shadow_rays", "nee");
-        if (policy != "nee") throw std::invalid_argument("unknown shadow-ray policy '" + policy + "' (supported: nee)");
-        integrator = std::make_unique<PathIntegrator>(o, std::make_unique<TraceAllShadowRays>());
+        std::unique_ptr<ShadowRayTester> shadow;
+        if (policy == "nee") {
+            shadow = std::make_unique<TraceAllShadowRays>();
+        } else {
+            NeeppOptions n;
+            n.policy = parse_shadow_ray_policy(policy);
+            n.voxels = options.get_int("voxels", n.voxels);
+            n.samples_per_pair = options.get_int("samples_per_pair", n.samples_per_pair);
+            n.q_min = options.get_float("q_min", n.q_min);
+            n.map_file = options.get_string("visibility_map", n.map_file);
+            n.learn = options.get_bool("learn", n.learn);
+            shadow = std::make_unique<NeeppShadowRays>(n);
+        }
+        integrator = std::make_unique<PathIntegrator>(o, std::move(shadow));
     } else {
         throw std::invalid_argument("unknown integrator '" + name + "' (supported: path)");
     }

@@ -12,6 +12,17 @@ PathIntegrator::PathIntegrator(PathOptions options, std::unique_ptr<ShadowRayTes
 
 void PathIntegrator::prepare(const Scene &scene) {
     light_sampler_ = make_light_sampler(options_.light_sampler, scene.light_pointers());
+    shadow_->prepare(scene);  // NEE++: build or load the visibility map
+}
+
+void PathIntegrator::end_pass(const Scene &, int) {
+    shadow_->end_pass();  // NEE++: merge what the pass learned into the map the next pass reads
+}
+
+nlohmann::json PathIntegrator::statistics() const {
+    nlohmann::json s = shadow_->statistics();
+    if (s.empty()) return nlohmann::json::object();
+    return {{"shadow_rays", s}};
 }
 
 nlohmann::json PathIntegrator::describe() const {
@@ -21,7 +32,8 @@ nlohmann::json PathIntegrator::describe() const {
             {"hide_emitters", options_.hide_emitters},
             {"nee", options_.nee},
             {"light_sampler", options_.light_sampler},
-            {"shadow_rays", shadow_->policy()}};
+            {"shadow_rays", shadow_->policy()},
+            {"shadow_ray_options", shadow_->describe()}};
 }
 
 float PathIntegrator::emission_weight(const Light &light, const LightSampleContext &prev, const DirectionSample &ds,
@@ -32,7 +44,7 @@ float PathIntegrator::emission_weight(const Light &light, const LightSampleConte
 }
 
 Color PathIntegrator::sample_direct(const Scene &scene, const SurfaceInteraction &si, const BSDF &bsdf,
-                                    Sampler &sampler, RenderCounters &counters) const {
+                                    const Color &beta, Sampler &sampler, RenderCounters &counters) const {
     LightSampleContext ctx{si.p, si.n};
     SampledLight sl = light_sampler_->sample(ctx, sampler.next_1d());
     Vec2 u = sampler.next_2d();
@@ -50,8 +62,9 @@ Color PathIntegrator::sample_direct(const Scene &scene, const SurfaceInteraction
     q.ray = ds.dist >= kInfinity ? si.spawn_ray(ds.d) : si.spawn_ray_to(ds.p);
     q.from = si.p;
     q.to = ds.p;
-    q.unoccluded = f * Le * (w / light_pdf);
-    return q.unoccluded * shadow_->visibility(scene, q, sampler, counters);
+    Color contribution = f * Le * (w / light_pdf);
+    q.unoccluded = beta * contribution;
+    return contribution * shadow_->visibility(scene, q, sampler, counters);
 }
 
 Color PathIntegrator::Li(const Scene &scene, const Ray &primary, Sampler &sampler, RenderCounters &counters) const {
@@ -90,7 +103,7 @@ Color PathIntegrator::Li(const Scene &scene, const Ray &primary, Sampler &sample
 
         const BSDF &bsdf = *si.shape->bsdf;
         if (options_.nee && bsdf.has_flag(BSDFSmooth))
-            L += beta * sample_direct(scene, si, bsdf, sampler, counters);
+            L += beta * sample_direct(scene, si, bsdf, beta, sampler, counters);
 
         float u1 = sampler.next_1d();
         Vec2 u2 = sampler.next_2d();

@@ -22,14 +22,20 @@ class PathIntegrator final : public Integrator {
 public:
     explicit PathIntegrator(PathOptions options, std::unique_ptr<ShadowRayTester> shadow);
     void prepare(const Scene &scene) override;
+    void end_pass(const Scene &scene, int pass_index) override;
+    nlohmann::json statistics() const override;
     Color Li(const Scene &scene, const Ray &ray, Sampler &sampler, RenderCounters &counters) const override;
     nlohmann::json describe() const override;
     const PathOptions &options() const { return options_; }
+    const ShadowRayTester &shadow_rays() const { return *shadow_; }
+    ShadowRayTester &shadow_rays() { return *shadow_; }
 
 private:
-    // Radiance from light sources by light sampling at si, MIS-weighted against BSDF sampling.
-    Color sample_direct(const Scene &scene, const SurfaceInteraction &si, const class BSDF &bsdf, Sampler &sampler,
-                        RenderCounters &counters) const;
+    // Radiance from light sources by light sampling at si, MIS-weighted against BSDF sampling (not yet
+    // multiplied by the path throughput beta, which is passed only so that contribution-aware shadow-ray
+    // policies see the sample's full contribution).
+    Color sample_direct(const Scene &scene, const SurfaceInteraction &si, const class BSDF &bsdf, const Color &beta,
+                        Sampler &sampler, RenderCounters &counters) const;
     // MIS weight for emission found by a BSDF-sampled ray leaving prev (pdf prev_pdf) toward light.
     float emission_weight(const Light &light, const LightSampleContext &prev, const DirectionSample &ds,
                           float prev_pdf) const;

@@ -111,7 +111,9 @@ RenderResult render(const Scene &scene, Integrator &integrator, const RenderJob 
                                 float px = float(x) + jitter.x, py = float(y) + jitter.y;
                                 Ray ray = cam.generate_ray({px / float(W), py / float(H)});
                                 Color L = integrator.Li(scene, ray, *sampler, c);
-                                if (!is_finite(L) || L.x < 0 || L.y < 0 || L.z < 0) {
+                                // Only NaN/inf are dropped: negative values are legitimate for unbiased
+                                // estimators such as NEE++'s control variate and must average out.
+                                if (!is_finite(L)) {
                                     ++c.invalid_samples;
                                     L = Color(0.f);
                                 }

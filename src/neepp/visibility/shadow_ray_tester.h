@@ -3,6 +3,7 @@
 // shadow-ray policies (Russian-roulette rejection driven by the visibility map) plug in.
 #pragma once
 #include <string>
+#include <nlohmann/json.hpp>
 #include "neepp/render/stats.h"
 #include "neepp/scene/interaction.h"
 
@@ -24,9 +25,20 @@ public:
     virtual ~ShadowRayTester() = default;
     // Returns the weight by which the unoccluded contribution is to be multiplied: 0 if occluded (or
     // rejected), 1 if visible, 1/q for a ray traced with probability q. Must be unbiased: E[weight] = V.
+    // A policy that plays Russian roulette draws its one random number from sampler.next_1d(), and only
+    // when a roulette actually happens. Called concurrently from the render threads.
     virtual float visibility(const Scene &scene, const ShadowQuery &q, Sampler &sampler,
                              RenderCounters &counters) const = 0;
     virtual std::string policy() const = 0;
+    // Hooks of the render loop, both single-threaded: prepare() before the first pass (build or load the
+    // visibility map), end_pass() after each pass (merge what the pass learned; the next pass reads the
+    // merged map, frozen).
+    virtual void prepare(const Scene &scene) {}
+    virtual void end_pass() {}
+    // The policy's effective options (for the integrator's description) and its figures (map size and
+    // build cost, roulette decisions...) for the statistics file.
+    virtual nlohmann::json describe() const { return {{"policy", policy()}}; }
+    virtual nlohmann::json statistics() const { return nlohmann::json::object(); }
 };
 
 // Plain next event estimation: every shadow ray is traced.

@@ -1,0 +1,144 @@
+#include "neepp/visibility/map_file.h"
+
+#include <cstring>
+#include <fstream>
+#include <iterator>
+#include <stdexcept>
+#include <fmt/format.h>
+#include "neepp/scene/scene.h"
+
+namespace neepp {
+
+namespace {
+
+constexpr char kMagic[8] = {'N', 'E', 'E', 'P', 'P', 'V', 'I', 'S'};
+constexpr uint32_t kVersion = 1;
+
+struct Writer {
+    std::string bytes;
+    template <typename T> void put(const T &v) { bytes.append(reinterpret_cast<const char *>(&v), sizeof(T)); }
+};
+
+struct Reader {
+    const std::string &bytes;
+    size_t pos = 0;
+    const std::string &path;
+    template <typename T> T get() {
+        if (pos + sizeof(T) > bytes.size()) throw std::runtime_error(fmt::format("visibility map '{}': file is truncated", path));
+        T v;
+        std::memcpy(&v, bytes.data() + pos, sizeof(T));
+        pos += sizeof(T);
+        return v;
+    }
+};
+
+}  // namespace
+
+uint64_t fnv1a64(const void *data, size_t bytes, uint64_t hash) {
+    const unsigned char *p = static_cast<const unsigned char *>(data);
+    for (size_t i = 0; i < bytes; ++i) {
+        hash ^= p[i];
+        hash *= 0x100000001b3ULL;
+    }
+    return hash;
+}
+
+uint64_t scene_fingerprint(const Scene &scene) {
+    uint64_t h = fnv1a64("neepp-scene-v1", 14);
+    auto mix = [&](const void *d, size_t n) { h = fnv1a64(d, n, h); };
+    uint64_t shapes = scene.shapes().size(), lights = scene.lights().size();
+    mix(&shapes, sizeof shapes);
+    for (const auto &s : scene.shapes()) {
+        int kind = int(s->kind);
+        mix(&kind, sizeof kind);
+        uint64_t np = s->positions.size(), ni = s->indices.size();
+        mix(&np, sizeof np);
+        mix(&ni, sizeof ni);
+        if (np) mix(s->positions.data(), np * sizeof(Vec3));
+        if (ni) mix(s->indices.data(), ni * sizeof(uint32_t));
+        mix(&s->center, sizeof(Vec3));
+        mix(&s->radius, sizeof(float));
+    }
+    mix(&lights, sizeof lights);
+    for (const auto &l : scene.lights()) {
+        uint8_t flags = uint8_t(l->is_infinite()) | uint8_t(l->is_delta() << 1);
+        mix(&flags, 1);
+    }
+    mix(&scene.bounds().lo, sizeof(Vec3));
+    mix(&scene.bounds().hi, sizeof(Vec3));
+    return h;
+}
+
+void save_visibility_map(const std::string &path, const VoxelGrid &grid, const VisibilityMap &map, uint64_t fingerprint) {
+    if (map.cell_count() != grid.cell_count())
+        throw std::invalid_argument("save_visibility_map: map and grid have different cell counts");
+    Writer w;
+    w.bytes.append(kMagic, 8);
+    w.put(kVersion);
+    w.put(uint32_t(grid.resolution()));
+    w.put(uint32_t(VoxelGrid::kDirectionBins));
+    w.put(grid.bounds().lo);
+    w.put(grid.bounds().hi);
+    w.put(fingerprint);
+    w.put(map.known_pairs());
+    const auto &data = map.data();
+    for (uint64_t i = 0; i < data.size(); ++i)
+        if (data[i].traced) {
+            w.put(uint32_t(i));
+            w.put(data[i].visible);
+            w.put(data[i].traced);
+        }
+    w.put(fnv1a64(w.bytes.data(), w.bytes.size()));
+    // Write beside the target and rename, so an interrupted save never leaves a half file under the name.
+    std::string tmp = path + ".tmp";
+    {
+        std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
+        out.write(w.bytes.data(), std::streamsize(w.bytes.size()));
+        if (!out) throw std::runtime_error(fmt::format("visibility map '{}': cannot write", path));
+    }
+    if (std::rename(tmp.c_str(), path.c_str()) != 0)
+        throw std::runtime_error(fmt::format("visibility map '{}': cannot rename {} to it", path, tmp));
+}
+
+VisibilityMap load_visibility_map(const std::string &path, const VoxelGrid &grid, uint64_t fingerprint) {
+    std::ifstream in(path, std::ios::binary);
+    if (!in) throw std::runtime_error(fmt::format("visibility map '{}': cannot open", path));
+    std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    auto fail = [&](const std::string &why) { return std::runtime_error(fmt::format("visibility map '{}': {}", path, why)); };
+    if (bytes.size() < 8 || std::memcmp(bytes.data(), kMagic, 8) != 0) throw fail("not a neepp visibility map (bad magic)");
+    if (bytes.size() < 8 + 4 + 8) throw fail("file is truncated");
+    // Checksum first: a damaged file must not be read any further, whatever the damage.
+    uint64_t stored;
+    std::memcpy(&stored, bytes.data() + bytes.size() - 8, 8);
+    uint64_t actual = fnv1a64(bytes.data(), bytes.size() - 8);
+    Reader r{bytes, 8, path};
+    uint32_t version = r.get<uint32_t>();
+    if (version != kVersion) throw fail(fmt::format("unsupported version {} (this build reads version {})", version, kVersion));
+    if (stored != actual)
+        throw fail(fmt::format("checksum mismatch (stored {:016x}, computed {:016x}): the file is damaged", stored, actual));
+    uint32_t n = r.get<uint32_t>(), bins = r.get<uint32_t>();
+    Vec3 lo = r.get<Vec3>(), hi = r.get<Vec3>();
+    uint64_t fp = r.get<uint64_t>(), entries = r.get<uint64_t>();
+    if (fp != fingerprint)
+        throw fail(fmt::format("belongs to another scene (scene fingerprint {:016x}, this scene {:016x})", fp, fingerprint));
+    if (int(n) != grid.resolution() || bins != uint32_t(VoxelGrid::kDirectionBins))
+        throw fail(fmt::format("was built for a {}^3 grid with {} direction bins, this render uses {}^3 with {}", n, bins,
+                               grid.resolution(), VoxelGrid::kDirectionBins));
+    if (!(lo == grid.bounds().lo) || !(hi == grid.bounds().hi)) throw fail("was built for other grid bounds");
+    VisibilityMap map(grid.cell_count());
+    if (bytes.size() - 8 - r.pos != entries * 8) throw fail("entry count does not match the file size");
+    int64_t last = -1;
+    for (uint64_t e = 0; e < entries; ++e) {
+        uint32_t pair = r.get<uint32_t>();
+        PairCounts c;
+        c.visible = r.get<uint16_t>();
+        c.traced = r.get<uint16_t>();
+        if (int64_t(pair) <= last || pair >= map.pair_count() || c.visible > c.traced || c.traced == 0)
+            throw fail(fmt::format("entry {} is malformed", e));
+        last = pair;
+        map.set(uint64_t(pair), c);
+    }
+    return map;
+}
+
+}  // namespace neepp

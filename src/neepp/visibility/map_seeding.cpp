@@ -1,0 +1,154 @@
+#include "neepp/visibility/map_seeding.h"
+
+#include <chrono>
+#include <stdexcept>
+#include <tbb/parallel_for.h>
+#include "neepp/math/frame.h"
+#include "neepp/math/warp.h"
+#include "neepp/sampling/rng.h"
+#include "neepp/scene/scene.h"
+
+namespace neepp {
+
+namespace {
+
+struct CellPoint {
+    Vec3 p;
+    Vec3 n;  // surface points: geometric normal on the side the path arrived from; light points: light normal (or 0)
+};
+
+// Reservoir sampling of up to k items per cell, in a fixed insertion order with a fixed generator.
+struct Reservoirs {
+    int k;
+    std::vector<std::vector<CellPoint>> items;
+    std::vector<uint64_t> seen;
+    PCG32 rng;
+    Reservoirs(uint32_t cells, int k_, uint64_t seed) : k(k_), items(cells), seen(cells, 0), rng(seed, 7) {}
+    void insert(uint32_t cell, const CellPoint &pt) {
+        uint64_t s = ++seen[cell];
+        if (items[cell].size() < size_t(k)) items[cell].push_back(pt);
+        else if (uint64_t j = uint64_t(rng.next_float() * float(s)); j < uint64_t(k)) items[cell][j] = pt;
+    }
+};
+
+// Shadow ray from surface point x (normal nx, facing the side rendering shades) toward y, stopping just
+// short of it like SurfaceInteraction::spawn_ray_to; or toward direction d when y is at infinity.
+Ray ray_between(const Vec3 &x, const Vec3 &nx, const Vec3 &target, bool infinite) {
+    Vec3 d = infinite ? target : target - x;
+    float eps = ray_epsilon(x);
+    Vec3 o = x + nx * (dot(d, nx) >= 0 ? eps : -eps);
+    if (infinite) return Ray{o, d, 0.f, kInfinity};
+    d = target - o;
+    float dist = norm(d);
+    return Ray{o, d / dist, 0.f, dist * (1.f - 1e-4f)};
+}
+
+}  // namespace
+
+SeedingStats seed_visibility_map(const Scene &scene, const VoxelGrid &grid, VisibilityMap &map,
+                                 const SeedingOptions &opt) {
+    if (map.cell_count() != grid.cell_count()) throw std::invalid_argument("seed_visibility_map: map/grid mismatch");
+    if (opt.samples_per_pair < 1) throw std::invalid_argument("samples_per_pair must be >= 1");
+    auto t0 = std::chrono::steady_clock::now();
+    SeedingStats stats;
+    const uint32_t cells = grid.cell_count();
+
+    // 1. Camera pre-pass: each path writes its points into its own slots, so the result is independent
+    //    of scheduling; they are then inserted into the reservoirs in path order.
+    const int G = std::max(1, opt.camera_grid), B = std::max(1, opt.bounces);
+    const size_t paths = size_t(G) * G;
+    std::vector<CellPoint> path_points(paths * B);
+    std::vector<uint8_t> path_len(paths, 0);
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, paths, 256), [&](const tbb::blocked_range<size_t> &r) {
+        for (size_t i = r.begin(); i != r.end(); ++i) {
+            PCG32 rng(mix_bits(opt.seed ^ mix_bits(i)), 1);
+            Vec2 film{(float(i % G) + rng.next_float()) / float(G), (float(i / G) + rng.next_float()) / float(G)};
+            Ray ray = scene.camera.generate_ray(film);
+            for (int b = 0; b < B; ++b) {
+                SurfaceInteraction si;
+                if (!scene.intersect(ray, si)) break;
+                Vec3 n = dot(si.n, ray.d) > 0 ? -si.n : si.n;  // the side the path arrived from
+                path_points[i * B + b] = {si.p, n};
+                path_len[i] = uint8_t(b + 1);
+                Vec3 d = Frame(n).to_world(square_to_cosine_hemisphere(rng.next_2d()));
+                float eps = ray_epsilon(si.p);
+                ray = Ray{si.p + n * eps, d, 0.f, kInfinity};
+            }
+        }
+    });
+    for (size_t i = 0; i < paths; ++i) stats.camera_rays += std::min<uint64_t>(uint64_t(path_len[i]) + 1, uint64_t(B));
+    Reservoirs surface(cells, opt.points_per_voxel, opt.seed + 1);
+    std::vector<CellPoint> all_points;
+    for (size_t i = 0; i < paths; ++i)
+        for (int b = 0; b < path_len[i]; ++b) {
+            const CellPoint &pt = path_points[i * B + b];
+            surface.insert(grid.voxel_of(pt.p), pt);
+            all_points.push_back(pt);
+        }
+    std::vector<uint32_t> shading_cells;
+    for (uint32_t c = 0; c < grid.voxel_count(); ++c)
+        if (!surface.items[c].empty()) shading_cells.push_back(c);
+    stats.occupied_voxels = shading_cells.size();
+
+    // 2. Light ends, sampled as NEE samples them from the recorded shading points. Light points keep the
+    //    light's normal; environment samples keep their direction (in p) and a zero normal.
+    Reservoirs light_ends(cells, opt.points_per_voxel, opt.seed + 2);
+    if (!all_points.empty()) {
+        PCG32 rng(opt.seed + 3, 3);
+        const size_t n_lights = std::max<size_t>(1, scene.lights().size());
+        const int per_light = int(std::min<size_t>(size_t(opt.light_samples_per_light), std::max<size_t>(256, (size_t(1) << 18) / n_lights)));
+        for (const auto &light : scene.lights())
+            for (int s = 0; s < per_light; ++s) {
+                const CellPoint &ref = all_points[std::min(all_points.size() - 1, size_t(rng.next_float() * float(all_points.size())))];
+                Color Le;
+                DirectionSample ds = light->sample_direction(ref.p, rng.next_2d(), Le);
+                if (is_black(Le) || !(ds.pdf > 0)) continue;
+                if (ds.dist >= kInfinity) light_ends.insert(grid.cell_of_direction(ds.d), {ds.d, Vec3(0.f)});
+                else light_ends.insert(grid.voxel_of(ds.p), {ds.p, ds.n});
+            }
+    }
+    std::vector<uint32_t> light_cells;
+    for (uint32_t c = 0; c < cells; ++c)
+        if (!light_ends.items[c].empty()) light_cells.push_back(c);
+    stats.light_cells = light_cells.size();
+
+    // 3. Explicit samples per (shading voxel, light cell) pair. Same-voxel pairs are skipped: the
+    //    policies always trace them. Samples whose direction lies behind the shading point's surface, or
+    //    that reach an area light from its back, are not traced: NEE never asks for them (the BSDF or the
+    //    emission is zero there), and counting them would bias the pair's estimate toward their outcome.
+    struct PairJob { uint32_t a, b; };
+    std::vector<PairJob> jobs;
+    for (uint32_t a : shading_cells)
+        for (uint32_t b : light_cells)
+            if (a != b) jobs.push_back({a, b});
+    std::vector<PairCounts> results(jobs.size());
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, jobs.size(), 16), [&](const tbb::blocked_range<size_t> &r) {
+        for (size_t j = r.begin(); j != r.end(); ++j) {
+            const auto &xs = surface.items[jobs[j].a];
+            const auto &ys = light_ends.items[jobs[j].b];
+            const bool infinite = grid.is_direction_cell(jobs[j].b);
+            PCG32 rng(mix_bits(opt.seed ^ mix_bits((uint64_t(jobs[j].a) << 32) | jobs[j].b)), 5);
+            uint32_t visible = 0, traced = 0;
+            for (int s = 0; s < opt.samples_per_pair; ++s) {
+                const CellPoint &x = xs[std::min(xs.size() - 1, size_t(rng.next_float() * float(xs.size())))];
+                const CellPoint &y = ys[std::min(ys.size() - 1, size_t(rng.next_float() * float(ys.size())))];
+                Vec3 d = infinite ? y.p : y.p - x.p;
+                if (dot(d, x.n) <= 0) continue;
+                if (!infinite && dot(y.n, d) >= 0 && squared_norm(y.n) > 0) continue;
+                ++traced;
+                visible += !scene.occluded(ray_between(x.p, x.n, y.p, infinite));
+            }
+            results[j] = {uint16_t(visible), uint16_t(traced)};
+        }
+    });
+    for (size_t j = 0; j < jobs.size(); ++j) {
+        if (!results[j].traced) continue;
+        map.add(jobs[j].a, jobs[j].b, results[j].visible, results[j].traced);
+        stats.shadow_rays += results[j].traced;
+        ++stats.seeded_pairs;
+    }
+    stats.time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    return stats;
+}
+
+}  // namespace neepp

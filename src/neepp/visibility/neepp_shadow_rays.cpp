@@ -1,0 +1,236 @@
+#include "neepp/visibility/neepp_shadow_rays.h"
+
+#include <chrono>
+#include <cmath>
+#include <filesystem>
+#include <stdexcept>
+#include "neepp/sampling/sampler.h"
+#include "neepp/scene/scene.h"
+#include "neepp/visibility/map_file.h"
+
+namespace neepp {
+
+ShadowRayPolicy parse_shadow_ray_policy(const std::string &name) {
+    if (name == "neepp") return ShadowRayPolicy::Neepp;
+    if (name == "neepp-adaptive") return ShadowRayPolicy::NeeppAdaptive;
+    if (name == "neepp-cv") return ShadowRayPolicy::NeeppCV;
+    throw std::invalid_argument("unknown shadow-ray policy '" + name + "' (supported: nee, neepp, neepp-adaptive, neepp-cv)");
+}
+
+std::string to_string(ShadowRayPolicy policy) {
+    switch (policy) {
+        case ShadowRayPolicy::Neepp: return "neepp";
+        case ShadowRayPolicy::NeeppAdaptive: return "neepp-adaptive";
+        case ShadowRayPolicy::NeeppCV: return "neepp-cv";
+    }
+    return "?";
+}
+
+NeeppShadowRays::NeeppShadowRays(NeeppOptions options) : options_(std::move(options)) {
+    if (!(options_.q_min > 0.f && options_.q_min <= 1.f))
+        throw std::invalid_argument("q_min must be in (0, 1]: q = 0 where visibility can be 1 would bias the image");
+    if (options_.samples_per_pair < 1 || options_.samples_per_pair > 4096)
+        throw std::invalid_argument("samples_per_pair must be in [1, 4096]");
+    if (options_.voxels < 1 || options_.voxels > VoxelGrid::kMaxResolution)
+        throw std::invalid_argument("voxels must be in [1, " + std::to_string(VoxelGrid::kMaxResolution) + "]");
+}
+
+float NeeppShadowRays::trace_probability(PairCounts c, bool same_cell, float lum) const {
+    if (same_cell || c.traced == 0) return 1.f;
+    const float v = VisibilityMap::estimate(c);
+    if (options_.policy == ShadowRayPolicy::NeeppAdaptive && adaptive_scale_ > 0) {
+        // NaN-safe: a NaN or negative luminance gives q_min, never 0.
+        double x = adaptive_scale_ * double(std::max(lum, 0.f)) * std::sqrt(double(v));
+        float q = float(std::min(x, 1.0));
+        return q >= options_.q_min ? q : options_.q_min;
+    }
+    return std::min(1.f, std::max(v, options_.q_min));
+}
+
+float NeeppShadowRays::visibility(const Scene &scene, const ShadowQuery &q, Sampler &sampler,
+                                  RenderCounters &counters) const {
+    // Shadow rays toward environment lights are spawned with an infinite tmax; they are keyed by direction.
+    const bool to_infinity = q.ray.tmax >= kInfinity;
+    const uint32_t a = grid_.voxel_of(q.from);
+    const uint32_t b = to_infinity ? grid_.cell_of_direction(q.ray.d) : grid_.voxel_of(q.to);
+    const uint64_t pair = VisibilityMap::pair_index(a, b);
+    const PairCounts c = map_.counts_at(pair);
+    ThreadState &ts = threads_.local();
+
+    auto trace = [&] {
+        bool visible = !trace_shadow_ray(scene, q.ray, counters);
+        if (options_.learn) ts.updates.record(pair, visible);
+        return visible;
+    };
+    if (a == b || c.traced == 0) {
+        ++(a == b ? ts.forced_same_cell : ts.forced_unknown);
+        return trace() ? 1.f : 0.f;
+    }
+
+    const float v = VisibilityMap::estimate(c);
+    const float lum = luminance(q.unoccluded);
+    const float prob = trace_probability(c, false, lum);
+    if (options_.policy == ShadowRayPolicy::NeeppAdaptive) {
+        ts.paper_q_sum_fixed += uint64_t(std::min(1.f, std::max(v, options_.q_min)) * kFixedOne);
+        double x = double(std::max(lum, 0.f)) * std::sqrt(double(v));
+        int bin = 0;
+        if (x > 0 && std::isfinite(x))
+            bin = std::clamp(int(std::floor((std::log2(x) - kHistMinLog2) * kHistBinsPerOctave)), 0, kHistBins - 1);
+        if (ts.histogram.empty()) ts.histogram.assign(kHistBins, 0);
+        ++ts.histogram[size_t(bin)];
+    }
+    ++ts.roulettes;
+    ts.q_sum_fixed += uint64_t(prob * kFixedOne);
+    if (prob >= 1.f) {  // no roulette, no random number
+        ++ts.roulette_traced;
+        return trace() ? 1.f : 0.f;  // q = 1: every policy's weight reduces to V
+    }
+    const float u = sampler.next_1d();
+    if (u < prob) {
+        ++ts.roulette_traced;
+        const float vis = trace() ? 1.f : 0.f;
+        if (options_.policy == ShadowRayPolicy::NeeppCV) return v + (vis - v) / prob;
+        return vis / prob;
+    }
+    ++ts.skipped;
+    ++counters.shadow_rays_skipped;
+    return options_.policy == ShadowRayPolicy::NeeppCV ? v : 0.f;
+}
+
+void NeeppShadowRays::adopt_map(const VoxelGrid &grid, VisibilityMap map) {
+    if (map.cell_count() != grid.cell_count()) throw std::invalid_argument("adopt_map: map and grid disagree");
+    grid_ = grid;
+    map_ = std::move(map);
+    adopted_ = true;
+    map_source_ = "adopted";
+}
+
+void NeeppShadowRays::prepare(const Scene &scene) {
+    threads_.clear();
+    totals_ = Totals{};
+    adaptive_scale_ = 0;
+    if (adopted_) return;
+    seeding_ = SeedingStats{};
+    load_time_s_ = 0;
+    grid_ = VoxelGrid(scene.bounds(), options_.voxels);
+    const uint64_t fingerprint = scene_fingerprint(scene);
+    if (!options_.map_file.empty() && std::filesystem::exists(options_.map_file)) {
+        // A file that exists but is damaged or belongs to another scene or grid is refused (throws), not
+        // silently overwritten: the user named it, and may have named the wrong one.
+        auto t0 = std::chrono::steady_clock::now();
+        map_ = load_visibility_map(options_.map_file, grid_, fingerprint);
+        load_time_s_ = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+        map_source_ = "loaded";
+        return;
+    }
+    map_ = VisibilityMap(grid_.cell_count());
+    SeedingOptions so;
+    so.samples_per_pair = options_.samples_per_pair;
+    seeding_ = seed_visibility_map(scene, grid_, map_, so);
+    map_source_ = "built";
+    if (!options_.map_file.empty()) save_visibility_map(options_.map_file, grid_, map_, fingerprint);
+}
+
+void NeeppShadowRays::calibrate_adaptive(const std::vector<uint64_t> &histogram, uint64_t roulettes,
+                                         uint64_t paper_q_sum_fixed) {
+    if (roulettes == 0 || histogram.empty()) return;
+    const double target = double(paper_q_sum_fixed) / kFixedOne / double(roulettes);
+    const double q_min = options_.q_min;
+    auto mean_q = [&](double log2c) {
+        double s = 0;
+        for (int i = 0; i < kHistBins; ++i)
+            if (histogram[size_t(i)]) {
+                double x = std::exp2(log2c + kHistMinLog2 + (i + 0.5) / kHistBinsPerOctave);
+                s += double(histogram[size_t(i)]) * std::clamp(x, q_min, 1.0);
+            }
+        return s / double(roulettes);
+    };
+    // mean_q is nondecreasing in c; bisect log2 c so the adaptive rule spends the paper's ray budget.
+    double lo = -200, hi = 200;
+    for (int it = 0; it < 80; ++it) {
+        double mid = 0.5 * (lo + hi);
+        (mean_q(mid) < target ? lo : hi) = mid;
+    }
+    adaptive_scale_ = std::exp2(0.5 * (lo + hi));
+}
+
+void NeeppShadowRays::end_pass() {
+    auto t0 = std::chrono::steady_clock::now();
+    // Sum every thread's updates per pair first (exact integer sums: independent of how tiles were spread
+    // over threads and of the order below), then apply each pair's sum once.
+    PairUpdateBuffer merged;
+    std::vector<uint64_t> histogram;
+    uint64_t roulettes = 0, paper_q = 0;
+    for (ThreadState &ts : threads_) {
+        ts.updates.for_each([&](uint64_t pair, uint32_t v, uint32_t t) { merged.add(pair, v, t); });
+        ts.updates.clear();
+        totals_.roulettes += ts.roulettes;
+        totals_.roulette_traced += ts.roulette_traced;
+        totals_.skipped += ts.skipped;
+        totals_.forced_unknown += ts.forced_unknown;
+        totals_.forced_same_cell += ts.forced_same_cell;
+        totals_.q_sum_fixed += ts.q_sum_fixed;
+        roulettes += ts.roulettes;
+        paper_q += ts.paper_q_sum_fixed;
+        if (!ts.histogram.empty()) {
+            if (histogram.empty()) histogram.assign(kHistBins, 0);
+            for (int i = 0; i < kHistBins; ++i) histogram[size_t(i)] += ts.histogram[size_t(i)];
+            std::fill(ts.histogram.begin(), ts.histogram.end(), 0);
+        }
+        ts.roulettes = ts.roulette_traced = ts.skipped = ts.forced_unknown = ts.forced_same_cell = 0;
+        ts.q_sum_fixed = ts.paper_q_sum_fixed = 0;
+    }
+    merged.for_each([&](uint64_t pair, uint32_t v, uint32_t t) {
+        map_.add(pair, v, t);
+        totals_.updates_merged += t;
+    });
+    if (options_.policy == ShadowRayPolicy::NeeppAdaptive) calibrate_adaptive(histogram, roulettes, paper_q);
+    ++totals_.passes;
+    totals_.merge_time_s += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
+nlohmann::json NeeppShadowRays::describe() const {
+    return {{"policy", policy()},
+            {"voxels", options_.voxels},
+            {"samples_per_pair", options_.samples_per_pair},
+            {"q_min", options_.q_min},
+            {"learn", options_.learn},
+            {"visibility_map", options_.map_file}};
+}
+
+nlohmann::json NeeppShadowRays::statistics() const {
+    nlohmann::json map = {
+        {"source", map_source_},
+        {"file", options_.map_file},
+        {"resolution", grid_.resolution()},
+        {"cells", grid_.cell_count()},
+        {"direction_bins", VoxelGrid::kDirectionBins},
+        {"memory_mb", double(map_.memory_bytes()) / (1024.0 * 1024.0)},
+        {"known_pairs", map_.cell_count() ? map_.known_pairs() : 0},
+        {"build_time_s", seeding_.time_s},
+        {"build_camera_rays", seeding_.camera_rays},
+        {"build_shadow_rays", seeding_.shadow_rays},
+        {"occupied_voxels", seeding_.occupied_voxels},
+        {"light_cells", seeding_.light_cells},
+        {"seeded_pairs", seeding_.seeded_pairs},
+        {"load_time_s", load_time_s_},
+    };
+    const uint64_t decided = totals_.roulettes + totals_.forced_unknown + totals_.forced_same_cell;
+    nlohmann::json roulette = {
+        {"queries", decided},
+        {"roulettes", totals_.roulettes},
+        {"roulette_traced", totals_.roulette_traced},
+        {"skipped", totals_.skipped},
+        {"traced_unknown_pair", totals_.forced_unknown},
+        {"traced_same_cell", totals_.forced_same_cell},
+        {"mean_q", totals_.roulettes ? double(totals_.q_sum_fixed) / kFixedOne / double(totals_.roulettes) : 1.0},
+        {"online_updates_merged", totals_.updates_merged},
+        {"passes_merged", totals_.passes},
+        {"merge_time_s", totals_.merge_time_s},
+    };
+    nlohmann::json j = {{"policy", policy()}, {"map", map}, {"roulette", roulette}};
+    if (options_.policy == ShadowRayPolicy::NeeppAdaptive) j["adaptive_scale"] = adaptive_scale_;
+    return j;
+}
+
+}  // namespace neepp

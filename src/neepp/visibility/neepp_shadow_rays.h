@@ -1,0 +1,107 @@
+// NEE++'s shadow-ray policies (Guo et al. 2020, see shared/design/NEEPP.md §1-2): a shadow ray from a
+// shading point in cell a toward a light point in cell b is traced only with probability q, chosen from
+// the visibility map's estimate Ṽ(a, b), and the result is reweighted so that E[weight] = V exactly.
+//   neepp           the paper: q = max(Ṽ, q_min); weight V/q when traced, 0 when skipped.
+//   neepp-adaptive  contribution-aware: q = clamp(c·lum(f)·sqrt(Ṽ), q_min, 1), which minimizes variance ×
+//                   shadow-ray cost (Σ f²Ṽ/q subject to Σ q fixed gives q ∝ f·sqrt(Ṽ)). The scale c is
+//                   calibrated after each pass so the expected number of rays traced equals what the
+//                   paper's rule would trace on that pass's queries (same cost, variance moved to dim
+//                   samples); the first pass, before any calibration, uses the paper's rule.
+//   neepp-cv        control variate: q = max(Ṽ, q_min); weight Ṽ when skipped, Ṽ + (V − Ṽ)/q when traced.
+//                   Same cost as neepp; per unit f², variance ν(1−ν)/q + (ν−Ṽ)²(1/q−1) for true visibility
+//                   probability ν (paper's rule: ν/q − ν²), i.e. 1−ν instead of 1−ν² when Ṽ = ν. The weight
+//                   is negative for a traced, occluded ray: any unbiased control variate needs that, so
+//                   the film must keep negative samples.
+// In every policy, pairs the map has never seen and same-voxel pairs (whose visibility the map cannot
+// resolve) are always traced, and q >= q_min > 0, so no sample with V = 1 is ever given zero probability.
+// Every traced ray also updates its pair's counts: per-thread buffers during a pass, merged by
+// end_pass() into the map that the next pass reads frozen.
+#pragma once
+#include <memory>
+#include <string>
+#include <tbb/enumerable_thread_specific.h>
+#include "neepp/visibility/map_seeding.h"
+#include "neepp/visibility/shadow_ray_tester.h"
+#include "neepp/visibility/update_buffer.h"
+#include "neepp/visibility/visibility_map.h"
+#include "neepp/visibility/voxel_grid.h"
+
+namespace neepp {
+
+enum class ShadowRayPolicy { Neepp, NeeppAdaptive, NeeppCV };
+// "neepp", "neepp-adaptive", "neepp-cv"; throws std::invalid_argument otherwise.
+ShadowRayPolicy parse_shadow_ray_policy(const std::string &name);
+std::string to_string(ShadowRayPolicy policy);
+
+struct NeeppOptions {
+    ShadowRayPolicy policy = ShadowRayPolicy::Neepp;
+    int voxels = 16;             // grid resolution N (the paper: higher is no better)
+    int samples_per_pair = 16;   // explicit samples per pair when seeding (the paper: 16 suffice)
+    // Lower bound of q. It bounds the weight 1/q and so the variance blow-up where the map is wrong
+    // (a pair estimated occluded that is in fact visible costs at most a factor 1/q_min in variance). 0.05
+    // is the low end of the range NEEPP.md names: with the default 16 seeding samples, a pair seen fully
+    // occluded has Ṽ = 1/18 ≈ 0.056, so q_min = 0.05 leaves the paper's rule untouched on the pairs that
+    // matter and only catches estimates pushed lower by online learning.
+    float q_min = 0.05f;
+    std::string map_file;        // load if present and matching, else build and save here; "" = no file
+    bool learn = true;           // update the map online from the shadow rays the render traces
+};
+
+class NeeppShadowRays final : public ShadowRayTester {
+public:
+    explicit NeeppShadowRays(NeeppOptions options);
+    float visibility(const Scene &scene, const ShadowQuery &q, Sampler &sampler, RenderCounters &counters) const override;
+    std::string policy() const override { return to_string(options_.policy); }
+    void prepare(const Scene &scene) override;
+    void end_pass() override;
+    nlohmann::json describe() const override;
+    nlohmann::json statistics() const override;
+
+    // Probability of tracing a query whose pair has counts c, for a contribution of luminance lum; 1 for
+    // unknown and same-cell pairs. Exposed so tests can check q > 0 over all inputs.
+    float trace_probability(PairCounts c, bool same_cell, float lum) const;
+    // Adaptive policy's current scale c (0 = not calibrated yet: the paper's rule is used).
+    double adaptive_scale() const { return adaptive_scale_; }
+    void set_adaptive_scale(double c) { adaptive_scale_ = c; }
+
+    const NeeppOptions &options() const { return options_; }
+    const VoxelGrid &grid() const { return grid_; }
+    const VisibilityMap &map() const { return map_; }
+    // For tests and tools (e.g. to plant a deliberately wrong map); not to be used during a pass.
+    VisibilityMap &mutable_map() { return map_; }
+    // Uses this grid and map instead of building one in prepare() (prepare then only resets the
+    // per-render state). The grid must cover the scene that will be rendered.
+    void adopt_map(const VoxelGrid &grid, VisibilityMap map);
+
+private:
+    // log2 histogram of lum(f)·sqrt(Ṽ) for the adaptive policy's calibration: integer counts, so the
+    // merged histogram (and c) does not depend on how tiles were spread over threads.
+    static constexpr int kHistBinsPerOctave = 4, kHistMinLog2 = -48, kHistBins = 96 * kHistBinsPerOctave;
+    static constexpr double kFixedOne = double(1 << 24);  // fixed-point scale of summed probabilities
+    struct ThreadState {
+        PairUpdateBuffer updates;
+        uint64_t roulettes = 0, roulette_traced = 0, skipped = 0, forced_unknown = 0, forced_same_cell = 0;
+        uint64_t q_sum_fixed = 0;          // Σ q over roulettes, fixed point
+        uint64_t paper_q_sum_fixed = 0;    // Σ max(Ṽ, q_min) over roulettes (the adaptive policy's budget)
+        std::vector<uint64_t> histogram;   // adaptive only
+    };
+    struct Totals {
+        uint64_t roulettes = 0, roulette_traced = 0, skipped = 0, forced_unknown = 0, forced_same_cell = 0;
+        uint64_t q_sum_fixed = 0, updates_merged = 0, passes = 0;
+        double merge_time_s = 0;
+    };
+    void calibrate_adaptive(const std::vector<uint64_t> &histogram, uint64_t roulettes, uint64_t paper_q_sum_fixed);
+
+    NeeppOptions options_;
+    VoxelGrid grid_;
+    VisibilityMap map_;
+    bool adopted_ = false;
+    std::string map_source_;  // built, loaded, adopted
+    SeedingStats seeding_;
+    double load_time_s_ = 0;
+    double adaptive_scale_ = 0;
+    Totals totals_;
+    mutable tbb::enumerable_thread_specific<ThreadState> threads_;
+};
+
+}  // namespace neepp
