@@ -1,5 +1,6 @@
 // Helpers for tests that render small scenes written inline as Mitsuba XML.
 #pragma once
+#include <gtest/gtest.h>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -57,6 +58,53 @@ inline MeanStderr pixel_statistics(const Image &img, int channel) {
     }
     double mean = s / double(n), var = std::max(0.0, s2 / double(n) - mean * mean);
     return {mean, std::sqrt(var / double(n))};
+}
+
+// Unbiasedness checks compare two estimators through coarse block means of the green channel, each
+// averaged over independently seeded renders: per block, the mean over seeds and the variance of that mean.
+struct BlockMoments {
+    std::vector<double> mean, var;
+};
+
+inline std::vector<double> block_means(const Image &img, int bx, int by) {
+    std::vector<double> blocks;
+    for (int y0 = 0; y0 + by <= img.height; y0 += by)
+        for (int x0 = 0; x0 + bx <= img.width; x0 += bx) {
+            double sum = 0;
+            for (int y = y0; y < y0 + by; ++y)
+                for (int x = x0; x < x0 + bx; ++x) sum += img.at(x, y, 1);
+            blocks.push_back(sum / (bx * by));
+        }
+    return blocks;
+}
+
+inline BlockMoments moments_over_seeds(const std::vector<std::vector<double>> &per_seed) {
+    BlockMoments m;
+    const size_t nb = per_seed.at(0).size(), seeds = per_seed.size();
+    m.mean.assign(nb, 0);
+    m.var.assign(nb, 0);
+    for (size_t b = 0; b < nb; ++b) {
+        for (auto &ps : per_seed) m.mean[b] += ps[b] / seeds;
+        for (auto &ps : per_seed) m.var[b] += (ps[b] - m.mean[b]) * (ps[b] - m.mean[b]) / (seeds - 1);
+        m.var[b] /= seeds;
+    }
+    return m;
+}
+
+// Two-sample z-tests per block (Bonferroni over ~12 blocks at a ~1e-3 family-wise level, with a generous
+// bound for the heavier tails of few-seed variance estimates) and on the whole-image mean.
+inline void expect_same_image(const BlockMoments &ref, const BlockMoments &test, const std::string &what) {
+    size_t nb = ref.mean.size();
+    double m_ref = 0, m_test = 0, v_ref = 0, v_test = 0;
+    for (size_t b = 0; b < nb; ++b) {
+        double z = (test.mean[b] - ref.mean[b]) / std::sqrt(ref.var[b] + test.var[b] + 1e-12);
+        EXPECT_LT(std::abs(z), 5.0) << what << ": block " << b << " reference " << ref.mean[b] << " tested " << test.mean[b];
+        m_ref += ref.mean[b] / nb; m_test += test.mean[b] / nb;
+        v_ref += ref.var[b] / (nb * nb); v_test += test.var[b] / (nb * nb);
+    }
+    double z = (m_test - m_ref) / std::sqrt(v_ref + v_test);
+    EXPECT_LT(std::abs(z), 4.0) << what << ": image mean reference " << m_ref << " tested " << m_test;
+    EXPECT_GT(m_ref, 1e-3) << what << ": the scene must be lit, or the test proves nothing";
 }
 
 }  // namespace neepp::testing

@@ -12,26 +12,14 @@
 #include "neepp/io/obj_reader.h"
 #include "neepp/io/ply_reader.h"
 #include "neepp/io/xml_tree.h"
+#include "common/temp_dir.h"
 
 using namespace neepp;
+using neepp::testing::TempDir;
 namespace fs = std::filesystem;
 
 namespace {
 
-// A scratch folder for the mesh files a test writes; removed afterwards.
-struct TempDir {
-    fs::path dir;
-    TempDir() {
-        dir = fs::temp_directory_path() / ("neepp_mesh_" + std::to_string(std::random_device{}()));
-        fs::create_directories(dir);
-    }
-    ~TempDir() { fs::remove_all(dir); }
-    std::string write(const std::string &name, const std::string &bytes) const {
-        std::string p = (dir / name).string();
-        std::ofstream(p, std::ios::binary) << bytes;
-        return p;
-    }
-};
 
 // Expects a SceneError whose message starts with the path and contains `needle`.
 template <class F>

@@ -6,27 +6,14 @@
 #include <functional>
 #include <random>
 #include "neepp/io/xml_tree.h"
+#include "common/temp_dir.h"
 
 using namespace neepp;
+using neepp::testing::TempDir;
 namespace fs = std::filesystem;
 
 namespace {
 
-// A scratch folder for the XML files a test writes; removed afterwards.
-struct TempDir {
-    fs::path dir;
-    TempDir() {
-        dir = fs::temp_directory_path() / ("neepp_xml_" + std::to_string(std::random_device{}()));
-        fs::create_directories(dir);
-    }
-    ~TempDir() { fs::remove_all(dir); }
-    std::string write(const std::string &name, const std::string &text) const {
-        fs::path p = dir / name;
-        fs::create_directories(p.parent_path());
-        std::ofstream(p) << text;
-        return p.string();
-    }
-};
 
 const char *kSceneDirs[] = {"bathroom", "classroom", "cornell-box", "living-room", "staircase", "veach-ajar"};
 

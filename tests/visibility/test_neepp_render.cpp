@@ -88,56 +88,22 @@ PolicyRun render_policy(const std::string &xml_path, const std::string &policy, 
     return run;
 }
 
-struct Moments {
-    std::vector<double> mean, var;  // per block (green channel), over seeds: mean and variance of the mean
+struct Moments : BlockMoments {
     uint64_t shadow_rays = 0, skipped = 0;
 };
 
 Moments block_moments(const std::string &path, const std::string &policy, int seeds, int spp, uint64_t seed0,
                       MapSetup setup = MapSetup::Built) {
-    const int bx = 6, by = 6;
     std::vector<std::vector<double>> per_seed;
     Moments m;
     for (int s = 0; s < seeds; ++s) {
         PolicyRun run = render_policy(path, policy, spp, seed0 + uint64_t(s) * 7919, setup);
         m.shadow_rays += run.counters.shadow_rays;
         m.skipped += run.counters.shadow_rays_skipped;
-        const Image &img = run.image;
-        std::vector<double> blocks;
-        for (int y0 = 0; y0 + by <= img.height; y0 += by)
-            for (int x0 = 0; x0 + bx <= img.width; x0 += bx) {
-                double sum = 0;
-                for (int y = y0; y < y0 + by; ++y)
-                    for (int x = x0; x < x0 + bx; ++x) sum += img.at(x, y, 1);
-                blocks.push_back(sum / (bx * by));
-            }
-        per_seed.push_back(blocks);
+        per_seed.push_back(block_means(run.image, 6, 6));
     }
-    size_t nb = per_seed[0].size();
-    m.mean.assign(nb, 0);
-    m.var.assign(nb, 0);
-    for (size_t b = 0; b < nb; ++b) {
-        for (auto &ps : per_seed) m.mean[b] += ps[b] / seeds;
-        for (auto &ps : per_seed) m.var[b] += (ps[b] - m.mean[b]) * (ps[b] - m.mean[b]) / (seeds - 1);
-        m.var[b] /= seeds;
-    }
+    static_cast<BlockMoments &>(m) = moments_over_seeds(per_seed);
     return m;
-}
-
-// Two-sample z-tests, Bonferroni over 12 blocks at a ~1e-3 family-wise level with a generous bound for
-// the heavier tails of 6-seed variance estimates (as test_nee_vs_bsdf.cpp).
-void expect_same_image(const Moments &ref, const Moments &test, const std::string &what) {
-    size_t nb = ref.mean.size();
-    double m_ref = 0, m_test = 0, v_ref = 0, v_test = 0;
-    for (size_t b = 0; b < nb; ++b) {
-        double z = (test.mean[b] - ref.mean[b]) / std::sqrt(ref.var[b] + test.var[b] + 1e-12);
-        EXPECT_LT(std::abs(z), 5.0) << what << ": block " << b << " nee " << ref.mean[b] << " policy " << test.mean[b];
-        m_ref += ref.mean[b] / nb; m_test += test.mean[b] / nb;
-        v_ref += ref.var[b] / (nb * nb); v_test += test.var[b] / (nb * nb);
-    }
-    double z = (m_test - m_ref) / std::sqrt(v_ref + v_test);
-    EXPECT_LT(std::abs(z), 4.0) << what << ": image mean nee " << m_ref << " policy " << m_test;
-    EXPECT_GT(m_ref, 1e-3) << what << ": the scene must be lit, or the test proves nothing";
 }
 
 constexpr int kSeeds = 6;
