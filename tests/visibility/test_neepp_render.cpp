@@ -15,32 +15,6 @@ using namespace neepp::testing;
 
 namespace {
 
-// Renders with the library's render loop, except for neepp-cv: its weight is negative for traced,
-// occluded rays, so a path's radiance can be negative, and the render loop (as of this writing) drops
-// negative samples as invalid. To test the estimator itself, cv goes through this minimal loop: passes
-// like the render loop's (1, 1, 2, 4...), box filter, end_pass between passes, negatives kept.
-Image render_keep_negative(const Scene &scene, Integrator &integ, int spp, uint64_t seed, RenderCounters &c) {
-    integ.prepare(scene);
-    const int W = scene.camera.width, H = scene.camera.height;
-    Image img(W, H, 3);
-    auto sampler = make_sampler("independent", seed);
-    for (int done = 0, pass = 0; done < spp; ++pass) {
-        int size = std::min(std::clamp(done, 1, 32), spp - done);
-        for (int y = 0; y < H; ++y)
-            for (int x = 0; x < W; ++x)
-                for (int s = done; s < done + size; ++s) {
-                    sampler->start_sample(uint32_t(x), uint32_t(y), uint32_t(s));
-                    Vec2 j = sampler->next_2d();
-                    Ray ray = scene.camera.generate_ray({(float(x) + j.x) / float(W), (float(y) + j.y) / float(H)});
-                    Color L = integ.Li(scene, ray, *sampler, c);
-                    for (int k = 0; k < 3; ++k) img.at(x, y, k) += L[k] / float(spp);
-                }
-        done += size;
-        integ.end_pass(scene, pass);
-    }
-    return img;
-}
-
 // How the map is made before a render: built by prepare() (the normal case), or planted wrong.
 enum class MapSetup { Built, ClaimsOccluded, FromClosedDoor };
 
@@ -74,18 +48,13 @@ PolicyRun render_policy(const std::string &xml_path, const std::string &policy, 
             tester->adopt_map(seeder.grid(), seeder.map());
         }
     }
-    PolicyRun run;
-    if (policy == "neepp-cv") {
-        run.image = render_keep_negative(*scene, *integ, spp, seed, run.counters);
-    } else {
-        RenderJob job;
-        job.spp = spp;
-        job.seed = seed;
-        RenderResult r = render(*scene, *integ, job);
-        run.image = r.image;
-        run.counters = r.counters;
-    }
-    return run;
+    // neepp-cv's weight is negative for traced, occluded rays: this also checks that the render loop keeps
+    // negative samples (dropping them would bias the image and fail the z-tests).
+    RenderJob job;
+    job.spp = spp;
+    job.seed = seed;
+    RenderResult r = render(*scene, *integ, job);
+    return PolicyRun{r.image, r.counters};
 }
 
 struct Moments : BlockMoments {

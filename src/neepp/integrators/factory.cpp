@@ -30,6 +30,14 @@ std::unique_ptr<Integrator> make_integrator(const std::string &name, const Optio
             n.q_min = options.get_float("q_min", n.q_min);
             n.map_file = options.get_string("visibility_map", n.map_file);
             n.learn = options.get_bool("learn", n.learn);
+            if (n.policy == ShadowRayPolicy::NeeppAdaptive) {
+                n.adaptive_target = options.get_string("adaptive_target", n.adaptive_target);
+                n.shadow_ray_cost = options.get_float("shadow_ray_cost", n.shadow_ray_cost);
+                if (n.adaptive_target != "efficiency" && n.adaptive_target != "rays")
+                    throw std::invalid_argument("adaptive_target must be 'efficiency' or 'rays'");
+                if (!(n.shadow_ray_cost > 0 && n.shadow_ray_cost <= 1))
+                    throw std::invalid_argument("shadow_ray_cost must be in (0, 1]");
+            }
             shadow = std::make_unique<NeeppShadowRays>(n);
         }
         integrator = std::make_unique<PathIntegrator>(o, std::move(shadow));

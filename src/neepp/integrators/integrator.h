@@ -6,6 +6,7 @@
 #include <string>
 #include <nlohmann/json.hpp>
 #include "neepp/integrators/options.h"
+#include "neepp/render/pass_statistics.h"
 #include "neepp/render/stats.h"
 #include "neepp/scene/interaction.h"
 
@@ -21,7 +22,7 @@ public:
     virtual void prepare(const Scene &scene) {}
     virtual Color Li(const Scene &scene, const Ray &ray, Sampler &sampler, RenderCounters &counters) const = 0;
     // Called between passes, single-threaded, after all samples of the pass are in.
-    virtual void end_pass(const Scene &scene, int pass_index) {}
+    virtual void end_pass(const Scene &scene, const PassStatistics &pass) {}
     // Name and effective options, for the statistics file.
     virtual nlohmann::json describe() const = 0;
     // Extra statistics of this integrator (map size, rays skipped...), merged into the stats file.

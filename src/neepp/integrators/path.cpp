@@ -15,8 +15,8 @@ void PathIntegrator::prepare(const Scene &scene) {
     shadow_->prepare(scene);  // NEE++: build or load the visibility map
 }
 
-void PathIntegrator::end_pass(const Scene &, int) {
-    shadow_->end_pass();  // NEE++: merge what the pass learned into the map the next pass reads
+void PathIntegrator::end_pass(const Scene &, const PassStatistics &pass) {
+    shadow_->end_pass(pass);  // NEE++: merge what the pass learned into the map the next pass reads
 }
 
 nlohmann::json PathIntegrator::statistics() const {

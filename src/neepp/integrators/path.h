@@ -22,7 +22,7 @@ class PathIntegrator final : public Integrator {
 public:
     explicit PathIntegrator(PathOptions options, std::unique_ptr<ShadowRayTester> shadow);
     void prepare(const Scene &scene) override;
-    void end_pass(const Scene &scene, int pass_index) override;
+    void end_pass(const Scene &scene, const PassStatistics &pass) override;
     nlohmann::json statistics() const override;
     Color Li(const Scene &scene, const Ray &ray, Sampler &sampler, RenderCounters &counters) const override;
     nlohmann::json describe() const override;

@@ -42,6 +42,27 @@ int next_pass_size(int done, int target, double seconds_per_spp, double remainin
     return size;
 }
 
+// Per-sample variance of the pixel estimates, from this pass's second moment and the image so far (see
+// PassStatistics). Floored at 1% of the second moment so a noise-free image does not give zero.
+PassStatistics pass_statistics(int pass_index, int spp, int pass_size, const std::vector<double> &tile_m2,
+                               const ImageBlock &accumulated) {
+    PassStatistics ps;
+    ps.pass_index = pass_index;
+    ps.spp = spp;
+    const Image img = accumulated.resolve();
+    const double pixels = double(img.width) * img.height;
+    double m2 = 0, mean_sq = 0;
+    for (double v : tile_m2) m2 += v;
+    m2 /= pixels * pass_size;
+    for (size_t i = 0; i < size_t(img.width) * img.height; ++i) {
+        double l = luminance(Color(img.data[3 * i], img.data[3 * i + 1], img.data[3 * i + 2]));
+        mean_sq += l * l;
+    }
+    mean_sq /= pixels;
+    ps.sample_variance = std::max(m2 - mean_sq, 0.01 * m2);
+    return ps;
+}
+
 }  // namespace
 
 RenderResult render(const Scene &scene, Integrator &integrator, const RenderJob &job) {
@@ -66,6 +87,7 @@ RenderResult render(const Scene &scene, Integrator &integrator, const RenderJob 
     const Clock::time_point start = Clock::now();
     auto elapsed = [&] { return std::chrono::duration<double>(Clock::now() - start).count(); };
 
+    std::vector<double> tile_m2(tiles.size());  // Σ lum(L)² per tile this pass, summed in tile order
     std::atomic<int> tiles_done{0};
     std::atomic<int> pass_size_now{0}, spp_done_now{0};
     auto fraction = [&]() -> double {
@@ -102,6 +124,7 @@ RenderResult render(const Scene &scene, Integrator &integrator, const RenderJob 
                         return;
                     }
                     const Tile &t = tiles[ti];
+                    double m2 = 0;
                     ImageBlock block(t.x0 - border, t.y0 - border, t.w + 2 * border, t.h + 2 * border, &filter);
                     for (int y = t.y0; y < t.y0 + t.h; ++y)
                         for (int x = t.x0; x < t.x0 + t.w; ++x)
@@ -118,7 +141,9 @@ RenderResult render(const Scene &scene, Integrator &integrator, const RenderJob 
                                     L = Color(0.f);
                                 }
                                 block.put(px, py, L);
+                                m2 += double(luminance(L)) * double(luminance(L));
                             }
+                    tile_m2[ti] = m2;
                     std::lock_guard<std::mutex> lock(merge_mutex);
                     pass_block.merge(block);
                     ++tiles_done;
@@ -134,7 +159,7 @@ RenderResult render(const Scene &scene, Integrator &integrator, const RenderJob 
         accumulated.merge(pass_block);
         result.spp += size;
         spp_done_now = result.spp;
-        integrator.end_pass(scene, result.passes);
+        integrator.end_pass(scene, pass_statistics(result.passes, result.spp, size, tile_m2, accumulated));
         ++result.passes;
         seconds_per_spp = (elapsed() - pass_start) / size;
         if (job.spp > 0 && result.spp >= job.spp) { result.stopped_by = "spp"; break; }

@@ -154,7 +154,7 @@ void NeeppShadowRays::calibrate_adaptive(const std::vector<uint64_t> &histogram,
     adaptive_scale_ = std::exp2(0.5 * (lo + hi));
 }
 
-void NeeppShadowRays::end_pass() {
+void NeeppShadowRays::end_pass(const PassStatistics &pass) {
     auto t0 = std::chrono::steady_clock::now();
     // Sum every thread's updates per pair first (exact integer sums: independent of how tiles were spread
     // over threads and of the order below), then apply each pair's sum once.
@@ -184,7 +184,11 @@ void NeeppShadowRays::end_pass() {
         map_.add(pair, v, t);
         totals_.updates_merged += t;
     });
-    if (options_.policy == ShadowRayPolicy::NeeppAdaptive) calibrate_adaptive(histogram, roulettes, paper_q);
+    if (options_.policy == ShadowRayPolicy::NeeppAdaptive) {
+        if (options_.adaptive_target == "rays") calibrate_adaptive(histogram, roulettes, paper_q);
+        else if (pass.sample_variance > 0)
+            adaptive_scale_ = 1.0 / std::sqrt(double(options_.shadow_ray_cost) * pass.sample_variance);
+    }
     ++totals_.passes;
     totals_.merge_time_s += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }

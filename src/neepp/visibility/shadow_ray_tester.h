@@ -4,6 +4,7 @@
 #pragma once
 #include <string>
 #include <nlohmann/json.hpp>
+#include "neepp/render/pass_statistics.h"
 #include "neepp/render/stats.h"
 #include "neepp/scene/interaction.h"
 
@@ -34,7 +35,7 @@ public:
     // visibility map), end_pass() after each pass (merge what the pass learned; the next pass reads the
     // merged map, frozen).
     virtual void prepare(const Scene &scene) {}
-    virtual void end_pass() {}
+    virtual void end_pass(const PassStatistics &) {}
     // The policy's effective options (for the integrator's description) and its figures (map size and
     // build cost, roulette decisions...) for the statistics file.
     virtual nlohmann::json describe() const { return {{"policy", policy()}}; }
