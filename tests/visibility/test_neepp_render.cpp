@@ -151,6 +151,30 @@ TEST(NeeppRender, ReproducibleForAGivenSeed) {
     }
 }
 
+// The efficiency target trades rays for variance by their cost: nearly free rays are (almost) all traced,
+// expensive ones skipped more than the paper's rule would.
+TEST(NeeppRender, AdaptiveEfficiencyFollowsTheShadowRayCost) {
+    auto traced_fraction = [](const std::string &cost) {
+        auto scene = load_scene(two_rooms_path());
+        auto integ = make_integrator("path", Options(OptionMap{{"shadow_rays", "neepp-adaptive"}, {"shadow_ray_cost", cost},
+                                                               {"max_depth", "4"}}));
+        RenderJob job;
+        job.spp = 16;
+        RenderResult r = render(*scene, *integ, job);
+        EXPECT_EQ(integ->describe()["shadow_ray_options"]["shadow_ray_cost"].get<float>(), std::stof(cost));
+        return double(r.counters.shadow_rays) / double(r.counters.shadow_rays + r.counters.shadow_rays_skipped);
+    };
+    double cheap = traced_fraction("0.000001"), dear = traced_fraction("1");
+    EXPECT_GT(cheap, 0.9) << "rays that cost nothing should nearly all be traced";
+    EXPECT_LT(dear, cheap - 0.2) << "expensive rays should be skipped more";
+    EXPECT_THROW(make_integrator("path", Options(OptionMap{{"shadow_rays", "neepp-adaptive"}, {"shadow_ray_cost", "0"}})),
+                 std::invalid_argument);
+    EXPECT_THROW(make_integrator("path", Options(OptionMap{{"shadow_rays", "neepp-adaptive"}, {"adaptive_target", "speed"}})),
+                 std::invalid_argument);
+    EXPECT_THROW(make_integrator("path", Options(OptionMap{{"shadow_rays", "neepp"}, {"shadow_ray_cost", "0.1"}})),
+                 std::invalid_argument);
+}
+
 TEST(NeeppRender, StatisticsDescribeTheMapAndTheRoulette) {
     auto scene = load_scene(two_rooms_path());
     auto integ = make_integrator("path", Options(OptionMap{{"shadow_rays", "neepp"}, {"voxels", "8"},

@@ -194,12 +194,17 @@ void NeeppShadowRays::end_pass(const PassStatistics &pass) {
 }
 
 nlohmann::json NeeppShadowRays::describe() const {
-    return {{"policy", policy()},
-            {"voxels", options_.voxels},
-            {"samples_per_pair", options_.samples_per_pair},
-            {"q_min", options_.q_min},
-            {"learn", options_.learn},
-            {"visibility_map", options_.map_file}};
+    nlohmann::json j = {{"policy", policy()},
+                        {"voxels", options_.voxels},
+                        {"samples_per_pair", options_.samples_per_pair},
+                        {"q_min", options_.q_min},
+                        {"learn", options_.learn},
+                        {"visibility_map", options_.map_file}};
+    if (options_.policy == ShadowRayPolicy::NeeppAdaptive) {
+        j["adaptive_target"] = options_.adaptive_target;
+        j["shadow_ray_cost"] = options_.shadow_ray_cost;
+    }
+    return j;
 }
 
 nlohmann::json NeeppShadowRays::statistics() const {
