@@ -326,6 +326,32 @@ TEST(EnvironmentMapLight, PdfIsPositiveWhereverRadianceIs) {
     EXPECT_GT(dark, 0);  // the black block is seen, so the test covers both kinds of direction
 }
 
+// Maps wider than the sampling grid are sampled on merged cells whose edges do not fall on texel edges
+// (1100 / 512): pdf and sampling must still agree, integrate to 1 and cover every lit texel, including a
+// single bright texel.
+Image make_large_env_image() {
+    const int w = 1100, h = 600;
+    Image img(w, h, 3);
+    for (int y = 0; y < h; ++y)
+        for (int x = 0; x < w; ++x)
+            for (int ch = 0; ch < 3; ++ch)
+                img.at(x, y, ch) = (x > 300 && x < 700 && y > 350 && y < 500) ? 0.f : 0.2f + 0.1f * std::sin(0.01f * float(x + ch * y));
+    for (int ch = 0; ch < 3; ++ch) img.at(777, 123, ch) = 100.f;
+    return img;
+}
+
+TEST(EnvironmentMapLight, LargeMapsSampleOnMergedCells) {
+    EnvironmentMapLight light(make_large_env_image(), kEnvToWorld, 1.f);
+    expect_samples_match_trace(light, Vec3(0.f), trace_environment(light));
+    Chi2Result r = chi2_light(light, Vec3(0.f), trace_environment(light), full_sphere());
+    ASSERT_TRUE(r.error.empty()) << r.describe();
+    EXPECT_GT(r.p_value, 1e-4) << r.describe();
+    EXPECT_NEAR(r.pdf_integral, 1.0, 2e-3) << r.describe();
+    // The bright texel's direction has a pdf far above the average (1 / 4pi): it is importance-sampled.
+    Vec3 spot = light.uv_to_direction(Vec2(777.f / 1100.f, 123.5f / 599.f));
+    EXPECT_GT(light.pdf_direction(Vec3(0.f), direction_sample_from_miss(spot)), 20.f * kInv4Pi);
+}
+
 TEST(EnvironmentMapLight, MitsubaOrientation) {
     // Local direction (sin(theta) sin(phi), cos(theta), -sin(theta) cos(phi)) with phi = 2 pi u,
     // theta = pi v: v = 0 is +y, v = 1 is -y, u = 0 faces -z, u = 0.25 faces +x, u = 0.5 faces +z.

@@ -28,7 +28,9 @@ private:
     Image image_;
     Transform to_world_;
     float scale_;
-    AliasTable cells_;  // one entry per texel cell, ∝ luminance × sin(theta)
+    static constexpr int kMaxSampleWidth = 512;
+    AliasTable cells_;  // sampling cells (texel cells merged down to at most 512x256), ∝ luminance × sin(theta)
+    int sample_w_ = 0, sample_h_ = 0;
     Color mean_radiance_;
     float scene_radius_ = 1.f;
 };

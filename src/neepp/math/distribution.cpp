@@ -110,9 +110,10 @@ AliasTable::AliasTable(const std::vector<float> &weights) {
     // Leftovers are 1 up to rounding: they keep themselves.
     for (uint32_t i : large) { bins_[i].threshold = 1.f; bins_[i].alias = i; }
     for (uint32_t i : small) { bins_[i].threshold = 1.f; bins_[i].alias = i; }
+    for (Bin &b : bins_) b.alias_pmf = bins_[b.alias].pmf;
 }
 
-uint32_t AliasTable::sample(Vec2 u, Vec2 &offset) const {
+uint32_t AliasTable::sample(Vec2 u, Vec2 &offset, float *pmf_out) const {
     // 48 random bits: the 24 mantissa bits of each sampler dimension.
     uint64_t bits = (uint64_t(double(u.x) * 0x1p24) << 24) | uint64_t(double(u.y) * 0x1p24);
     unsigned __int128 scaled = (unsigned __int128)bits * bins_.size();
@@ -122,9 +123,11 @@ uint32_t AliasTable::sample(Vec2 u, Vec2 &offset) const {
     double rest;
     if (frac < b.threshold) {
         rest = frac / b.threshold;
+        if (pmf_out) *pmf_out = b.pmf;
     } else {
         rest = (frac - b.threshold) / (1.0 - b.threshold);
         i = b.alias;
+        if (pmf_out) *pmf_out = b.alias_pmf;
     }
     // Split the leftover variate into two: its coarse part and its fine part scaled back up.
     double fine = rest * 4096.0;

@@ -60,14 +60,16 @@ public:
     // choice (a single float has too few bits to pick among millions of bins without bias); what is
     // left over comes back in `offset` as a point uniform in [0,1)^2 to ~12 bits per axis, enough to
     // place a sample inside the chosen cell.
-    uint32_t sample(Vec2 u, Vec2 &offset) const;
+    // pmf_out (optional) receives the chosen index's pmf, read from the same cache line.
+    uint32_t sample(Vec2 u, Vec2 &offset, float *pmf_out = nullptr) const;
     float pmf(uint32_t i) const { return bins_[i].pmf; }
 
 private:
     struct Bin {
         float threshold;  // probability of keeping this bin rather than jumping to its alias
         uint32_t alias;
-        float pmf;        // weight / total, stored beside the rest so sampling touches one cache line
+        float pmf;        // weight / total of this bin
+        float alias_pmf;  // ... and of its alias, so a sample touches one 16-byte bin, one cache line
     };
     std::vector<Bin> bins_;
     float total_ = 0;
