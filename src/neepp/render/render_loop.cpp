@@ -31,12 +31,14 @@ std::vector<Tile> make_tiles(int width, int height, int size) {
 }
 
 // Samples per pass: small passes first so NEE++ and the time estimate learn early, then growing
-// geometrically (capped) so per-pass overhead stays negligible.
+// geometrically (capped) so per-pass overhead stays negligible. Under a time limit a pass is sized to end
+// before the deadline by the speed of the last pass (with a 5% margin): a pass is all or nothing, so one
+// cut off by the deadline would be work thrown away.
 int next_pass_size(int done, int target, double seconds_per_spp, double remaining_s, bool timed) {
     int size = std::clamp(done, 1, 32);
     if (target > 0) size = std::min(size, target - done);
     if (timed && seconds_per_spp > 0) {
-        double affordable = std::floor(remaining_s / seconds_per_spp);
+        double affordable = std::floor(0.95 * remaining_s / seconds_per_spp);
         size = int(std::min<double>(size, affordable));
     }
     return size;
@@ -119,7 +121,11 @@ RenderResult render(const Scene &scene, Integrator &integrator, const RenderJob 
                 RenderCounters &c = counters.local();
                 for (size_t ti = r.begin(); ti != r.end(); ++ti) {
                     if (aborted.load(std::memory_order_relaxed)) return;
-                    if ((job.cancel && job.cancel->load()) || (timed && elapsed() > job.time_limit_s)) {
+                    // A time limit cuts a pass short only when it overruns badly (the first pass, whose speed
+                    // was unknown, or a wrong estimate): otherwise the pass, sized to fit, is finished.
+                    const bool overrun = timed && (result.passes == 0 ? elapsed() > job.time_limit_s
+                                                                      : elapsed() > 1.25 * job.time_limit_s);
+                    if ((job.cancel && job.cancel->load()) || overrun) {
                         aborted = true;
                         return;
                     }

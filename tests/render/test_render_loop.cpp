@@ -1,0 +1,71 @@
+// The render loop: sample counts, time limits and cancellation, always ending with an image.
+#include <gtest/gtest.h>
+#include <atomic>
+#include <thread>
+#include "test_scenes.h"
+
+using namespace neepp;
+using namespace neepp::testing;
+
+namespace {
+
+std::unique_ptr<Scene> demo_scene(int w, int h) {
+    return load_scene(std::string(NEEPP_SOURCE_DIR) + "/scenes/door-ajar/scene.xml",
+                      {{"resx", std::to_string(w)}, {"resy", std::to_string(h)}});
+}
+
+TEST(RenderLoop, ReachesTheSampleCountInPasses) {
+    auto scene = demo_scene(32, 18);
+    auto integ = make_integrator("path", Options(scene->settings.integrator_options));
+    RenderJob job;
+    job.spp = 37;
+    RenderResult r = render(*scene, *integ, job);
+    EXPECT_EQ(r.spp, 37);
+    EXPECT_EQ(r.stopped_by, "spp");
+    EXPECT_GT(r.passes, 3);  // small first passes, so per-pass hooks (NEE++) learn early
+    EXPECT_EQ(r.counters.rays >= uint64_t(37 * 32 * 18), true);
+    EXPECT_GT(pixel_statistics(r.image, 0).mean, 0.0);
+}
+
+TEST(RenderLoop, TimeLimitUsesTheBudgetAndStops) {
+    auto scene = demo_scene(64, 36);
+    auto integ = make_integrator("path", Options(scene->settings.integrator_options));
+    RenderJob job;
+    job.spp = 0;
+    job.time_limit_s = 0.6;
+    RenderResult r = render(*scene, *integ, job);
+    EXPECT_EQ(r.stopped_by, "time");
+    EXPECT_GE(r.spp, 1);
+    EXPECT_LT(r.render_time_s, 0.6 * 1.3);
+    // Passes are sized to fit: most of the budget turns into samples (none thrown away by a cut-off pass).
+    EXPECT_GT(r.render_time_s, 0.6 * 0.5);
+}
+
+TEST(RenderLoop, CancelStopsEarlyWithTheImageSoFar) {
+    auto scene = demo_scene(64, 36);
+    auto integ = make_integrator("path", Options(scene->settings.integrator_options));
+    std::atomic<bool> cancel{false};
+    RenderJob job;
+    job.spp = 1 << 20;
+    job.cancel = &cancel;
+    std::thread stopper([&] {
+        std::this_thread::sleep_for(std::chrono::milliseconds(300));
+        cancel = true;
+    });
+    RenderResult r = render(*scene, *integ, job);
+    stopper.join();
+    EXPECT_EQ(r.stopped_by, "cancel");
+    EXPECT_LT(r.spp, 1 << 20);
+    EXPECT_EQ(r.image.width, 64);
+    EXPECT_GT(pixel_statistics(r.image, 0).mean, 0.0);
+}
+
+TEST(RenderLoop, NeedsASampleCountOrATimeLimit) {
+    auto scene = demo_scene(8, 8);
+    auto integ = make_integrator("path", Options());
+    RenderJob job;
+    job.spp = 0;
+    EXPECT_THROW(render(*scene, *integ, job), std::invalid_argument);
+}
+
+}  // namespace
