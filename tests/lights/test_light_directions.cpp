@@ -50,7 +50,7 @@ std::optional<SurfaceInteraction> intersect(const Shape &shape, const Ray &ray) 
         if (b1 < 0 || b2 < 0 || b1 + b2 > 1 || t <= 0 || t >= best_t) continue;
         best_t = t;
         SurfaceInteraction si;
-        shape.fill_interaction(prim, float(b1), float(b2), Vec3(), ray, float(t), si);
+        shape.fill_interaction(prim, float(b1), float(b2), ray, float(t), si);
         best = si;
     }
     return best;

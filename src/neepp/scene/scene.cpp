@@ -103,7 +103,7 @@ bool Scene::intersect(const Ray &ray, SurfaceInteraction &si) const {
         return false;
     }
     const Shape &s = *shapes_[rh.hit.geomID];
-    s.fill_interaction(rh.hit.primID, rh.hit.u, rh.hit.v, Vec3(rh.hit.Ng_x, rh.hit.Ng_y, rh.hit.Ng_z), ray,
+    s.fill_interaction(rh.hit.primID, rh.hit.u, rh.hit.v, ray,
                        rh.ray.tfar, si);
     si.wi = si.to_local(-ray.d);
     return true;

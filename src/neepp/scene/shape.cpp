@@ -54,7 +54,7 @@ PositionSample Shape::sample_position(Vec2 u) const {
     return ps;
 }
 
-void Shape::fill_interaction(uint32_t prim, float b1, float b2, const Vec3 &ng_embree, const Ray &ray, float t,
+void Shape::fill_interaction(uint32_t prim, float b1, float b2, const Ray &ray, float t,
                              SurfaceInteraction &si) const {
     si.t = t;
     si.p = ray.at(t);
@@ -78,7 +78,6 @@ void Shape::fill_interaction(uint32_t prim, float b1, float b2, const Vec3 &ng_e
     float b0 = 1.f - b1 - b2;
     Vec3 e1 = p1 - p0, e2 = p2 - p0;
     Vec3 ng = normalize(cross(e1, e2));
-    (void)ng_embree;
     if (flip_normals) ng = -ng;
     si.n = ng;
     si.p = p0 * b0 + p1 * b1 + p2 * b2;

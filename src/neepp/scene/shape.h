@@ -49,7 +49,7 @@ struct Shape {
     float pdf_position() const { return area_ > 0 ? 1.f / area_ : 0.f; }
 
     // Completes a hit record from Embree's primitive index and barycentrics (or sphere hit).
-    void fill_interaction(uint32_t prim, float b1, float b2, const Vec3 &ng_embree, const Ray &ray, float t,
+    void fill_interaction(uint32_t prim, float b1, float b2, const Ray &ray, float t,
                           SurfaceInteraction &si) const;
 
 private:
