@@ -63,6 +63,16 @@ public:
     bool has_flag(uint32_t f) const { return (flags() & f) != 0; }
 };
 
+// Base of BSDFs made only of delta lobes (smooth conductor, dielectrics): no direction has a finite
+// density, so they can only be sampled, never evaluated.
+class DeltaOnlyBSDF : public BSDF {
+public:
+    Color eval(const BSDFContext &, const SurfaceInteraction &, const Vec3 &, const Vec3 &) const final {
+        return Color(0.f);
+    }
+    float pdf(const BSDFContext &, const SurfaceInteraction &, const Vec3 &, const Vec3 &) const final { return 0.f; }
+};
+
 using BSDFPtr = std::shared_ptr<const BSDF>;
 
 }  // namespace neepp

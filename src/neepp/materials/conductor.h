@@ -11,16 +11,10 @@
 
 namespace neepp {
 
-class ConductorBSDF final : public BSDF {
+class ConductorBSDF final : public DeltaOnlyBSDF {
 public:
     // A null specular_reflectance means 1.
     ConductorBSDF(TexturePtr eta, TexturePtr k, TexturePtr specular_reflectance = nullptr);
-    Color eval(const BSDFContext &, const SurfaceInteraction &, const Vec3 &, const Vec3 &) const override {
-        return Color(0.f);
-    }
-    float pdf(const BSDFContext &, const SurfaceInteraction &, const Vec3 &, const Vec3 &) const override {
-        return 0.f;
-    }
     BSDFSample sample(const BSDFContext &ctx, const SurfaceInteraction &si, const Vec3 &wi, float u1,
                       Vec2 u2) const override;
     uint32_t flags() const override { return BSDFDeltaReflection; }

@@ -12,17 +12,11 @@
 
 namespace neepp {
 
-class DielectricBSDF final : public BSDF {
+class DielectricBSDF final : public DeltaOnlyBSDF {
 public:
     // Null textures mean 1.
     DielectricBSDF(float int_ior, float ext_ior, TexturePtr specular_reflectance = nullptr,
                    TexturePtr specular_transmittance = nullptr);
-    Color eval(const BSDFContext &, const SurfaceInteraction &, const Vec3 &, const Vec3 &) const override {
-        return Color(0.f);
-    }
-    float pdf(const BSDFContext &, const SurfaceInteraction &, const Vec3 &, const Vec3 &) const override {
-        return 0.f;
-    }
     BSDFSample sample(const BSDFContext &ctx, const SurfaceInteraction &si, const Vec3 &wi, float u1,
                       Vec2 u2) const override;
     uint32_t flags() const override { return BSDFDeltaReflection | BSDFDeltaTransmission; }
