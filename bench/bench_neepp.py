@@ -62,6 +62,20 @@ def row_for(policy, r, ref, base):
     return row
 
 
+def run_policies(policies, name, ref, render_one):
+    """Renders every policy with render_one(policy, out_name) -> RenderResult; rows (ratios to the first,
+    `nee`) and images."""
+    rows, base, images = [], None, {}
+    for policy in policies:
+        r = render_one(policy, f"{policy}_{name}.exr")
+        row = row_for(policy, r, ref, base)
+        base = base or row
+        rows.append(row)
+        images[policy] = r.image
+        print(json.dumps(row), flush=True)
+    return rows, images
+
+
 def table(rows) -> str:
     columns = list(dict.fromkeys(k for r in rows for k in r))  # union of keys, first-seen order
     return report.markdown_table(rows, columns)
@@ -96,15 +110,9 @@ def main(argv=None) -> int:
             md.append(f"_{credit(scene)}_\n")
         results[scene] = {"equal_spp": {}, "equal_time": {}}
         for spp in spps:
-            rows, base, images = [], None, {}
-            for policy in policies:
-                r = render(xml, out / scene / f"{policy}_{spp}spp.exr", policy, spp=spp, w=w, h=h,
-                           max_depth=a.max_depth, seed=a.seed, threads=a.threads, options=options)
-                row = row_for(policy, r, ref, base)
-                base = base or row
-                rows.append(row)
-                images[policy] = r.image
-                print(json.dumps(row), flush=True)
+            rows, images = run_policies(policies, f"{spp}spp", ref, lambda policy, name: render(
+                xml, out / scene / name, policy, spp=spp, w=w, h=h, max_depth=a.max_depth, seed=a.seed,
+                threads=a.threads, options=options))
             results[scene]["equal_spp"][spp] = rows
             md.append(f"\n### equal spp: {spp}\n\n" + table(rows) + "\n")
             report.comparison_figure(out / scene / f"compare_{spp}spp.png", images, ref=ref,
@@ -112,13 +120,9 @@ def main(argv=None) -> int:
         # Equal time: every policy gets the wall time `nee` used at the middle sample count.
         mid = spps[len(spps) // 2]
         budget = next(r for r in results[scene]["equal_spp"][mid] if r["policy"] == "nee")["render_s"]
-        rows, base = [], None
-        for policy in policies:
-            r = render(xml, out / scene / f"{policy}_equal_time.exr", policy, time_s=budget, w=w, h=h,
-                       max_depth=a.max_depth, seed=a.seed, threads=a.threads, options=options)
-            row = row_for(policy, r, ref, base)
-            base = base or row
-            rows.append(row)
+        rows, _ = run_policies(policies, "equal_time", ref, lambda policy, name: render(
+            xml, out / scene / name, policy, time_s=budget, w=w, h=h, max_depth=a.max_depth, seed=a.seed,
+            threads=a.threads, options=options))
         results[scene]["equal_time"] = {"budget_s": budget, "rows": rows}
         md.append(f"\n### equal time: {budget:.2f} s (nee's time at {mid} spp)\n\n" + table(rows) + "\n")
         (out / "results.json").write_text(json.dumps(results, indent=2))

@@ -10,7 +10,7 @@ using namespace neepp::testing;
 
 namespace {
 
-std::string inner_furnace_xml(float rho, float le, int max_depth, const std::string &bsdf_extra = "") {
+std::string inner_furnace_xml(float rho, float le, int max_depth) {
     return fmt::format(R"(<scene version="3.0.0">
   <integrator type="path"><integer name="max_depth" value="{max_depth}"/></integrator>
   <sensor type="perspective">

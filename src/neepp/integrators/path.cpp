@@ -62,9 +62,8 @@ Color PathIntegrator::sample_direct(const Scene &scene, const SurfaceInteraction
     q.ray = ds.dist >= kInfinity ? si.spawn_ray(ds.d) : si.spawn_ray_to(ds.p);
     q.from = si.p;
     q.to = ds.p;
-    Color contribution = f * Le * (w / light_pdf);
-    q.unoccluded = beta * contribution;
-    return contribution * shadow_->visibility(scene, q, sampler, counters);
+    q.unoccluded = beta * f * Le * (w / light_pdf);
+    return q.unoccluded * shadow_->visibility(scene, q, sampler, counters);
 }
 
 Color PathIntegrator::Li(const Scene &scene, const Ray &primary, Sampler &sampler, RenderCounters &counters) const {
@@ -103,7 +102,7 @@ Color PathIntegrator::Li(const Scene &scene, const Ray &primary, Sampler &sample
 
         const BSDF &bsdf = *si.shape->bsdf;
         if (options_.nee && bsdf.has_flag(BSDFSmooth))
-            L += beta * sample_direct(scene, si, bsdf, beta, sampler, counters);
+            L += sample_direct(scene, si, bsdf, beta, sampler, counters);
 
         float u1 = sampler.next_1d();
         Vec2 u2 = sampler.next_2d();

@@ -31,9 +31,9 @@ public:
     ShadowRayTester &shadow_rays() { return *shadow_; }
 
 private:
-    // Radiance from light sources by light sampling at si, MIS-weighted against BSDF sampling (not yet
-    // multiplied by the path throughput beta, which is passed only so that contribution-aware shadow-ray
-    // policies see the sample's full contribution).
+    // Radiance from light sources by light sampling at si, MIS-weighted against BSDF sampling and
+    // multiplied by the path throughput beta (so contribution-aware shadow-ray policies see the sample's
+    // full contribution).
     Color sample_direct(const Scene &scene, const SurfaceInteraction &si, const class BSDF &bsdf, const Color &beta,
                         Sampler &sampler, RenderCounters &counters) const;
     // MIS weight for emission found by a BSDF-sampled ray leaving prev (pdf prev_pdf) toward light.
