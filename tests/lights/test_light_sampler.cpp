@@ -5,7 +5,7 @@
 
 #include "common/chi2.h"
 #include "neepp/lights/environment_light.h"
-#include "neepp/lights/light_sampler.h"
+#include "neepp/light_selection/factory.h"
 
 namespace neepp::test {
 namespace {
@@ -106,7 +106,7 @@ TEST(LightSampler, EmptyAndUnknown) {
         EXPECT_EQ(s.light, nullptr);
         EXPECT_EQ(s.pmf, 0.f);
     }
-    EXPECT_THROW(make_light_sampler("bvh", {}), std::invalid_argument);
+    EXPECT_THROW(make_light_sampler("nonsense", {}), std::invalid_argument);
 }
 
 }  // namespace

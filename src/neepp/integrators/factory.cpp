@@ -1,5 +1,7 @@
 #include <stdexcept>
+#include <algorithm>
 #include "neepp/integrators/path.h"
+#include "neepp/light_selection/factory.h"
 #include "neepp/visibility/neepp_shadow_rays.h"
 
 namespace neepp {
@@ -13,19 +15,24 @@ std::unique_ptr<Integrator> make_integrator(const std::string &name, const Optio
         o.hide_emitters = options.get_bool("hide_emitters", o.hide_emitters);
         o.nee = options.get_bool("nee", o.nee);
         o.light_sampler = options.get_string("light_sampler", o.light_sampler);
+        const auto &names = light_sampler_names();
+        if (std::find(names.begin(), names.end(), o.light_sampler) == names.end())
+            make_light_sampler(o.light_sampler, {});  // throws, listing the names
         if (o.max_depth < -1 || o.max_depth == 0) throw std::invalid_argument("max_depth must be -1 or >= 1");
         if (o.rr_depth < 1) throw std::invalid_argument("rr_depth must be >= 1");
         // Shadow-ray policy: nee traces every shadow ray; the neepp* policies (NEE++) play Russian roulette
-        // driven by a visibility map. Their options are only accepted with them, so a typo'd or
-        // meaningless option is still reported as unused.
+        // driven by a visibility map. Their options are only accepted with them (or with a light sampler
+        // that reads the map), so a typo'd or meaningless option is still reported as unused.
         std::string policy = options.get_string("shadow_rays", "nee");
+        const bool needs_map = light_sampler_needs_visibility_map(o.light_sampler);
+        if (o.light_sampler == "spatial" || needs_map || policy != "nee") o.voxels = options.get_int("voxels", o.voxels);
         std::unique_ptr<ShadowRayTester> shadow;
-        if (policy == "nee") {
+        if (policy == "nee" && !needs_map) {
             shadow = std::make_unique<TraceAllShadowRays>();
         } else {
             NeeppOptions n;
             n.policy = parse_shadow_ray_policy(policy);
-            n.voxels = options.get_int("voxels", n.voxels);
+            n.voxels = o.voxels;
             n.samples_per_pair = options.get_int("samples_per_pair", n.samples_per_pair);
             n.q_min = options.get_float("q_min", n.q_min);
             n.map_file = options.get_string("visibility_map", n.map_file);

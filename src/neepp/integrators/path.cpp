@@ -1,5 +1,6 @@
 #include "neepp/integrators/path.h"
 
+#include "neepp/light_selection/factory.h"
 #include "neepp/materials/bsdf.h"
 #include "neepp/math/warp.h"
 #include "neepp/sampling/sampler.h"
@@ -11,18 +12,22 @@ PathIntegrator::PathIntegrator(PathOptions options, std::unique_ptr<ShadowRayTes
     : options_(std::move(options)), shadow_(std::move(shadow)) {}
 
 void PathIntegrator::prepare(const Scene &scene) {
-    light_sampler_ = make_light_sampler(options_.light_sampler, scene.light_pointers());
     shadow_->prepare(scene);  // NEE++: build or load the visibility map
+    LightSelectionInputs inputs{&scene, shadow_->voxel_grid(), shadow_->visibility_map(), options_.voxels};
+    light_sampler_ = make_light_sampler(options_.light_sampler, scene.light_pointers(), inputs);
 }
 
 void PathIntegrator::end_pass(const Scene &, const PassStatistics &pass) {
-    shadow_->end_pass(pass);  // NEE++: merge what the pass learned into the map the next pass reads
+    shadow_->end_pass(pass);     // NEE++: merge what the pass learned into the map the next pass reads
+    light_sampler_->end_pass();  // ... and rebuild the light distributions that read it
 }
 
 nlohmann::json PathIntegrator::statistics() const {
-    nlohmann::json s = shadow_->statistics();
-    if (s.empty()) return nlohmann::json::object();
-    return {{"shadow_rays", s}};
+    nlohmann::json out = nlohmann::json::object();
+    if (nlohmann::json s = shadow_->statistics(); !s.empty()) out["shadow_rays"] = s;
+    if (light_sampler_)
+        if (nlohmann::json l = light_sampler_->statistics(); !l.empty()) out["light_sampler"] = l;
+    return out;
 }
 
 nlohmann::json PathIntegrator::describe() const {

@@ -16,6 +16,7 @@ struct PathOptions {
     bool hide_emitters = false;
     bool nee = true;
     std::string light_sampler = "power";
+    int voxels = 16;  // grid of the spatial light sampler when NEE++ keeps no map (else the map's grid)
 };
 
 class PathIntegrator final : public Integrator {

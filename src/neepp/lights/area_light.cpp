@@ -32,3 +32,33 @@ Color AreaLight::eval_surface(const SurfaceInteraction &si, const Vec3 &w) const
 }
 
 }  // namespace neepp
+
+namespace neepp {
+
+std::optional<LightBounds> AreaLight::bounds() const {
+    LightBounds b;
+    b.bounds = shape_->bounds();
+    b.phi = luminance(power());
+    b.cos_theta_e = 0.f;  // cosine emission: nothing beyond 90 degrees from the normal
+    if (shape_->kind == Shape::Kind::Sphere) {
+        b.normals = DirectionCone::entire_sphere();
+        return b;
+    }
+    // Union of the face normals, as the emission side is the geometric normal's (flipped if asked).
+    bool first = true;
+    for (size_t t = 0; t < shape_->triangle_count(); ++t) {
+        const Vec3 &p0 = shape_->positions[shape_->indices[3 * t]];
+        const Vec3 &p1 = shape_->positions[shape_->indices[3 * t + 1]];
+        const Vec3 &p2 = shape_->positions[shape_->indices[3 * t + 2]];
+        Vec3 c = cross(p1 - p0, p2 - p0);
+        float len = norm(c);
+        if (!(len > 0)) continue;  // degenerate: zero area, never sampled
+        DirectionCone face{(shape_->flip_normals ? -c : c) / len, 1.f};
+        b.normals = first ? face : cone_union(b.normals, face);
+        first = false;
+        if (b.normals.is_entire_sphere()) break;
+    }
+    return b;
+}
+
+}  // namespace neepp

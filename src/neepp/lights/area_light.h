@@ -13,6 +13,8 @@ public:
     float pdf_direction(const Vec3 &ref, const DirectionSample &ds) const override;
     Color eval_surface(const SurfaceInteraction &si, const Vec3 &w) const override;
     Color power() const override { return radiance_->mean() * (kPi * shape_->surface_area()); }
+    // The shape's box, a cone around its face normals, one-sided cosine emission.
+    std::optional<LightBounds> bounds() const override;
     const Shape *shape() const { return shape_; }
 
 private:

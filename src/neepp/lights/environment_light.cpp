@@ -145,3 +145,16 @@ DirectionSample PointLight::sample_direction(const Vec3 &ref, Vec2, Color &radia
 }
 
 }  // namespace neepp
+
+namespace neepp {
+
+std::optional<LightBounds> PointLight::bounds() const {
+    LightBounds b;
+    b.bounds.expand(position_);
+    b.normals = DirectionCone::entire_sphere();
+    b.cos_theta_e = 0.f;  // isotropic: theta_o = pi already covers every direction
+    b.phi = luminance(power());
+    return b;
+}
+
+}  // namespace neepp

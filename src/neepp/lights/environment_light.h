@@ -58,6 +58,7 @@ public:
     float pdf_direction(const Vec3 &, const DirectionSample &) const override { return 0.f; }
     Color power() const override { return intensity_ * (4.f * kPi); }
     bool is_delta() const override { return true; }
+    std::optional<LightBounds> bounds() const override;
     Vec3 position() const { return position_; }
 
 private:

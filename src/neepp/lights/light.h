@@ -2,6 +2,8 @@
 #pragma once
 #include <cstdint>
 #include <memory>
+#include <optional>
+#include "neepp/lights/light_bounds.h"
 #include "neepp/math/bbox.h"
 #include "neepp/scene/interaction.h"
 
@@ -35,6 +37,8 @@ public:
     virtual bool is_delta() const { return false; }
     // Called once the scene bounds are known (infinite lights need them for power and sample points).
     virtual void set_scene_bounds(const BBox &) {}
+    // Where and which way the light emits, for the light BVH; none for infinite lights (sampled apart).
+    virtual std::optional<LightBounds> bounds() const { return std::nullopt; }
 
     uint32_t index = 0;  // position in Scene::lights, for light samplers' tables
 };

@@ -1,7 +1,5 @@
 #include "neepp/lights/light_sampler.h"
 
-#include <stdexcept>
-
 namespace neepp {
 
 SampledLight UniformLightSampler::sample(const LightSampleContext &, float u) const {
@@ -37,12 +35,6 @@ SampledLight PowerLightSampler::sample(const LightSampleContext &, float u) cons
 
 float PowerLightSampler::pmf(const LightSampleContext &, const Light &light) const {
     return light.index < pmf_by_index_.size() ? pmf_by_index_[light.index] : 0.f;
-}
-
-std::unique_ptr<LightSampler> make_light_sampler(const std::string &name, std::vector<const Light *> lights) {
-    if (name == "uniform") return std::make_unique<UniformLightSampler>(std::move(lights));
-    if (name == "power") return std::make_unique<PowerLightSampler>(std::move(lights));
-    throw std::invalid_argument("unknown light sampler '" + name + "' (supported: uniform, power)");
 }
 
 }  // namespace neepp

@@ -5,6 +5,7 @@
 #include <memory>
 #include <string>
 #include <vector>
+#include <nlohmann/json.hpp>
 #include "neepp/lights/light.h"
 #include "neepp/math/distribution.h"
 
@@ -27,6 +28,11 @@ public:
     virtual SampledLight sample(const LightSampleContext &ctx, float u) const = 0;
     virtual float pmf(const LightSampleContext &ctx, const Light &light) const = 0;
     virtual std::string name() const = 0;
+    // Called between passes, single-threaded: samplers whose tables follow the visibility map rebuild
+    // them here (the next pass reads them frozen, so the pmf stays exact within a pass).
+    virtual void end_pass() {}
+    // Table counts, build times... for the statistics file.
+    virtual nlohmann::json statistics() const { return nlohmann::json::object(); }
 };
 
 class UniformLightSampler final : public LightSampler {
@@ -55,7 +61,5 @@ private:
     Distribution1D distribution_;
     std::vector<float> pmf_by_index_;  // indexed by Light::index
 };
-
-std::unique_ptr<LightSampler> make_light_sampler(const std::string &name, std::vector<const Light *> lights);
 
 }  // namespace neepp

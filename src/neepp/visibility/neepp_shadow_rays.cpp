@@ -11,6 +11,7 @@
 namespace neepp {
 
 ShadowRayPolicy parse_shadow_ray_policy(const std::string &name) {
+    if (name == "nee") return ShadowRayPolicy::TraceAll;
     if (name == "neepp") return ShadowRayPolicy::Neepp;
     if (name == "neepp-adaptive") return ShadowRayPolicy::NeeppAdaptive;
     if (name == "neepp-cv") return ShadowRayPolicy::NeeppCV;
@@ -19,6 +20,7 @@ ShadowRayPolicy parse_shadow_ray_policy(const std::string &name) {
 
 std::string to_string(ShadowRayPolicy policy) {
     switch (policy) {
+        case ShadowRayPolicy::TraceAll: return "nee";
         case ShadowRayPolicy::Neepp: return "neepp";
         case ShadowRayPolicy::NeeppAdaptive: return "neepp-adaptive";
         case ShadowRayPolicy::NeeppCV: return "neepp-cv";
@@ -36,7 +38,7 @@ NeeppShadowRays::NeeppShadowRays(NeeppOptions options) : options_(std::move(opti
 }
 
 float NeeppShadowRays::trace_probability(PairCounts c, bool same_cell, float lum) const {
-    if (same_cell || c.traced == 0) return 1.f;
+    if (same_cell || c.traced == 0 || options_.policy == ShadowRayPolicy::TraceAll) return 1.f;
     const float v = VisibilityMap::estimate(c);
     if (options_.policy == ShadowRayPolicy::NeeppAdaptive && adaptive_scale_ > 0) {
         // NaN-safe: a NaN or negative luminance gives q_min, never 0.
@@ -62,6 +64,7 @@ float NeeppShadowRays::visibility(const Scene &scene, const ShadowQuery &q, Samp
         if (options_.learn) ts.updates.record(pair, visible);
         return visible;
     };
+    if (options_.policy == ShadowRayPolicy::TraceAll) return trace() ? 1.f : 0.f;
     if (a == b || c.traced == 0) {
         ++(a == b ? ts.forced_same_cell : ts.forced_unknown);
         return trace() ? 1.f : 0.f;

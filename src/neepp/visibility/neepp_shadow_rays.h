@@ -28,8 +28,10 @@
 
 namespace neepp {
 
-enum class ShadowRayPolicy { Neepp, NeeppAdaptive, NeeppCV };
-// "neepp", "neepp-adaptive", "neepp-cv"; throws std::invalid_argument otherwise.
+// TraceAll ("nee") traces every shadow ray like TraceAllShadowRays but keeps (and learns) the map, for
+// visibility-aware light selection without rejection.
+enum class ShadowRayPolicy { TraceAll, Neepp, NeeppAdaptive, NeeppCV };
+// "nee", "neepp", "neepp-adaptive", "neepp-cv"; throws std::invalid_argument otherwise.
 ShadowRayPolicy parse_shadow_ray_policy(const std::string &name);
 std::string to_string(ShadowRayPolicy policy);
 
@@ -75,6 +77,8 @@ public:
     double adaptive_scale() const { return adaptive_scale_; }
     void set_adaptive_scale(double c) { adaptive_scale_ = c; }
 
+    const VoxelGrid *voxel_grid() const override { return &grid_; }
+    const VisibilityMap *visibility_map() const override { return &map_; }
     const NeeppOptions &options() const { return options_; }
     const VoxelGrid &grid() const { return grid_; }
     const VisibilityMap &map() const { return map_; }

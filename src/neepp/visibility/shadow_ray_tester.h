@@ -12,6 +12,8 @@ namespace neepp {
 
 class Scene;
 class Sampler;
+class VoxelGrid;
+class VisibilityMap;
 
 // Everything a policy may use to decide whether to trace: the ray, both end points, and the unoccluded
 // contribution the sample would add (for contribution-aware policies).
@@ -40,6 +42,10 @@ public:
     // build cost, roulette decisions...) for the statistics file.
     virtual nlohmann::json describe() const { return {{"policy", policy()}}; }
     virtual nlohmann::json statistics() const { return nlohmann::json::object(); }
+    // NEE++'s grid and visibility map, when this component keeps one (for visibility-aware light
+    // selection); valid after prepare(), updated by end_pass().
+    virtual const VoxelGrid *voxel_grid() const { return nullptr; }
+    virtual const VisibilityMap *visibility_map() const { return nullptr; }
 };
 
 // Plain next event estimation: every shadow ray is traced.

@@ -1,0 +1,183 @@
+#include "neepp/light_selection/bvh_light_sampler.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace neepp {
+
+namespace {
+
+constexpr float kOneMinusEpsilon = 0x1.fffffep-1f;
+
+// Conty & Kulla's orientation measure: the solid angle (cosine-weighted beyond theta_o) into which a
+// cone of normals with emission spread theta_e can send light.
+float orientation_measure(const LightBounds &b) {
+    const float theta_o = std::acos(std::clamp(b.normals.cos_theta, -1.f, 1.f));
+    const float theta_e = std::acos(std::clamp(b.cos_theta_e, -1.f, 1.f));
+    const float theta_w = std::min(theta_o + theta_e, kPi);
+    const float sin_o = std::sin(theta_o), cos_o = std::cos(theta_o);
+    return 2 * kPi * (1 - cos_o) +
+           kPi / 2 * (2 * theta_w * sin_o - std::cos(theta_o - 2 * theta_w) - 2 * theta_o * sin_o + cos_o);
+}
+
+float surface_area(const BBox &b) {
+    const Vec3 e = vmax(b.extent(), Vec3(0.f));
+    return 2 * (e.x * e.y + e.y * e.z + e.z * e.x);
+}
+
+}  // namespace
+
+BVHLightSampler::BVHLightSampler(std::vector<const Light *> lights) {
+    uint32_t max_index = 0;
+    for (const Light *l : lights) max_index = std::max(max_index, l->index);
+    trails_.assign(lights.empty() ? 0 : max_index + 1, Trail{});
+    is_infinite_.assign(trails_.size(), 0);
+    light_by_index_.assign(trails_.size(), nullptr);
+    for (const Light *l : lights) light_by_index_[l->index] = l;
+    std::vector<std::pair<const Light *, LightBounds>> items;
+    for (const Light *l : lights) {
+        std::optional<LightBounds> b = l->is_infinite() ? std::nullopt : l->bounds();
+        if (!b) {  // infinite (or unbounded) lights are chosen apart
+            infinite_.push_back(l);
+            is_infinite_[l->index] = 1;
+        } else if (b->phi > 0) {  // a light without power can light nothing: leave it out
+            items.emplace_back(l, *b);
+        }
+    }
+    if (!items.empty()) build(items, 0, items.size(), 0, 0);
+}
+
+uint32_t BVHLightSampler::build(std::vector<std::pair<const Light *, LightBounds>> &items, size_t begin, size_t end,
+                                uint64_t bits, int depth) {
+    depth_ = std::max(depth_, depth);
+    const uint32_t index = uint32_t(nodes_.size());
+    if (end - begin == 1) {
+        nodes_.push_back({items[begin].second, items[begin].first->index, true});
+        trails_[items[begin].first->index] = {bits, depth};
+        return index;
+    }
+    LightBounds all;
+    BBox centroids;
+    for (size_t i = begin; i < end; ++i) {
+        all = bounds_union(all, items[i].second);
+        centroids.expand(items[i].second.bounds.center());
+    }
+
+    // Surface-area-orientation heuristic over 12 buckets per axis; the trail is 64 bits, so deep trees
+    // (only reachable with adversarial inputs) fall back to halving by count.
+    size_t mid = begin + (end - begin) / 2;
+    const Vec3 extent = all.bounds.extent();
+    const float max_extent = max_component(extent);
+    float best_cost = kInfinity;
+    int best_axis = -1, best_bucket = -1;
+    constexpr int kBuckets = 12;
+    if (depth < 48) {
+        for (int axis = 0; axis < 3; ++axis) {
+            const float lo = centroids.lo[axis], hi = centroids.hi[axis];
+            if (!(hi > lo)) continue;
+            LightBounds buckets[kBuckets];
+            for (size_t i = begin; i < end; ++i) {
+                int b = std::min(int(kBuckets * (items[i].second.bounds.center()[axis] - lo) / (hi - lo)), kBuckets - 1);
+                buckets[b] = bounds_union(buckets[b], items[i].second);
+            }
+            auto cost_of = [](const LightBounds &b) {
+                return b.phi > 0 ? b.phi * orientation_measure(b) * surface_area(b.bounds) : 0.f;
+            };
+            // Regularizer: thin slabs cut along their long axis are preferred.
+            const float kr = extent[axis] > 0 ? max_extent / extent[axis] : 1.f;
+            for (int split = 1; split < kBuckets; ++split) {
+                LightBounds below, above;
+                for (int b = 0; b < split; ++b) below = bounds_union(below, buckets[b]);
+                for (int b = split; b < kBuckets; ++b) above = bounds_union(above, buckets[b]);
+                if (below.phi <= 0 || above.phi <= 0) continue;
+                const float cost = kr * (cost_of(below) + cost_of(above));
+                if (cost < best_cost) { best_cost = cost; best_axis = axis; best_bucket = split; }
+            }
+        }
+    }
+    if (best_axis >= 0) {
+        const float lo = centroids.lo[best_axis], hi = centroids.hi[best_axis];
+        auto it = std::partition(items.begin() + ptrdiff_t(begin), items.begin() + ptrdiff_t(end), [&](const auto &item) {
+            int b = std::min(int(kBuckets * (item.second.bounds.center()[best_axis] - lo) / (hi - lo)), kBuckets - 1);
+            return b < best_bucket;
+        });
+        mid = size_t(it - items.begin());
+    }
+    if (mid == begin || mid == end) mid = begin + (end - begin) / 2;
+
+    nodes_.push_back({all, 0, false});
+    build(items, begin, mid, bits, depth + 1);
+    const uint32_t second = build(items, mid, end, bits | (uint64_t(1) << depth), depth + 1);
+    nodes_[index].child_or_light = second;
+    return index;
+}
+
+float BVHLightSampler::infinite_probability() const {
+    if (infinite_.empty()) return 0.f;
+    return float(infinite_.size()) / float(infinite_.size() + (nodes_.empty() ? 0 : 1));
+}
+
+SampledLight BVHLightSampler::sample(const LightSampleContext &ctx, float u) const {
+    const float p_inf = infinite_probability();
+    if (u < p_inf) {
+        u = std::min(u / p_inf, kOneMinusEpsilon);
+        size_t i = std::min(size_t(u * float(infinite_.size())), infinite_.size() - 1);
+        return {infinite_[i], p_inf / float(infinite_.size())};
+    }
+    if (nodes_.empty()) return {};
+    u = std::min((u - p_inf) / (1 - p_inf), kOneMinusEpsilon);
+    float pmf = 1 - p_inf;
+    uint32_t node = 0;
+    while (!nodes_[node].leaf) {
+        const uint32_t first = node + 1, second = nodes_[node].child_or_light;
+        const float i0 = nodes_[first].bounds.importance(ctx.p, ctx.n);
+        const float i1 = nodes_[second].bounds.importance(ctx.p, ctx.n);
+        if (!(i0 > 0) && !(i1 > 0)) return {};
+        const float p0 = i0 / (i0 + i1);
+        if (u < p0) {
+            u = std::min(u / p0, kOneMinusEpsilon);
+            pmf *= p0;
+            node = first;
+        } else {
+            u = std::min((u - p0) / (1 - p0), kOneMinusEpsilon);
+            pmf *= 1 - p0;
+            node = second;
+        }
+    }
+    // A leaf reached through a sibling's importance may itself light nothing here.
+    if (!(nodes_[node].bounds.importance(ctx.p, ctx.n) > 0)) return {};
+    const uint32_t light = nodes_[node].child_or_light;
+    return {light_by_index_[light], pmf};
+}
+
+float BVHLightSampler::pmf(const LightSampleContext &ctx, const Light &light) const {
+    if (light.index >= trails_.size()) return 0.f;
+    const float p_inf = infinite_probability();
+    if (is_infinite_[light.index]) return p_inf / float(infinite_.size());
+    const Trail trail = trails_[light.index];
+    if (trail.length < 0) return 0.f;
+    float pmf = 1 - p_inf;
+    uint32_t node = 0;
+    for (int d = 0; d < trail.length; ++d) {
+        const uint32_t first = node + 1, second = nodes_[node].child_or_light;
+        const float i0 = nodes_[first].bounds.importance(ctx.p, ctx.n);
+        const float i1 = nodes_[second].bounds.importance(ctx.p, ctx.n);
+        if (!(i0 > 0) && !(i1 > 0)) return 0.f;
+        const float p0 = i0 / (i0 + i1);
+        if ((trail.bits >> d) & 1) {
+            pmf *= 1 - p0;
+            node = second;
+        } else {
+            pmf *= p0;
+            node = first;
+        }
+    }
+    if (!(nodes_[node].bounds.importance(ctx.p, ctx.n) > 0)) return 0.f;
+    return pmf;
+}
+
+nlohmann::json BVHLightSampler::statistics() const {
+    return {{"nodes", nodes_.size()}, {"depth", depth_}, {"infinite_lights", infinite_.size()}};
+}
+
+}  // namespace neepp

@@ -1,0 +1,47 @@
+// The light BVH of Conty Estevez & Kulla (2018), the state-of-the-art many-light baseline (as pbrt-v4's
+// `bvh` light sampler): lights with finite extent sit in a binary tree whose nodes bound position,
+// emission direction and power; a light is chosen by descending from the root, picking each child in
+// proportion to its importance at the shading point (LightBounds::importance). Infinite lights are
+// chosen apart, each with the probability of one BVH. The pmf of a light is the product of the branch
+// probabilities along its path, recomputed exactly by following the path stored per light.
+#pragma once
+#include <cstdint>
+#include <vector>
+#include "neepp/lights/light_sampler.h"
+
+namespace neepp {
+
+class BVHLightSampler final : public LightSampler {
+public:
+    explicit BVHLightSampler(std::vector<const Light *> lights);
+    SampledLight sample(const LightSampleContext &ctx, float u) const override;
+    float pmf(const LightSampleContext &ctx, const Light &light) const override;
+    std::string name() const override { return "bvh"; }
+    nlohmann::json statistics() const override;
+
+    size_t node_count() const { return nodes_.size(); }
+    int depth() const { return depth_; }
+
+private:
+    struct Node {
+        LightBounds bounds;
+        uint32_t child_or_light = 0;  // interior: second child (the first is the next node); leaf: light
+        bool leaf = false;
+    };
+    struct Trail {
+        uint64_t bits = 0;  // bit d: went to the second child at depth d
+        int length = -1;    // -1: not in the BVH
+    };
+    uint32_t build(std::vector<std::pair<const Light *, LightBounds>> &items, size_t begin, size_t end,
+                   uint64_t bits, int depth);
+    float infinite_probability() const;
+
+    std::vector<const Light *> infinite_;
+    std::vector<Node> nodes_;
+    std::vector<Trail> trails_;  // by Light::index
+    std::vector<const Light *> light_by_index_;
+    std::vector<uint8_t> is_infinite_;  // by Light::index
+    int depth_ = 0;
+};
+
+}  // namespace neepp

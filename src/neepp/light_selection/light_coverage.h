@@ -1,0 +1,22 @@
+// Which cells of the NEE++ grid a light covers, and how much of it lies in each: the "list of voxels a
+// light is linked to" of the paper. Found by drawing the light's own samples (Light::sample_direction),
+// so a cell weighs what it weighs among the end points of the shadow rays NEE traces toward that light:
+// area for area lights, luminance for environment maps (whose cells are the grid's direction bins).
+#pragma once
+#include <vector>
+#include "neepp/lights/light.h"
+#include "neepp/visibility/voxel_grid.h"
+
+namespace neepp {
+
+struct CellWeight {
+    uint32_t cell;
+    float weight;  // fractions summing to 1 over a light's cells
+};
+
+// One list per light, indexed like `lights`. `reference` is where samples are drawn from (it only
+// matters for lights whose sampling depends on it: their visible part is what counts from there).
+std::vector<std::vector<CellWeight>> light_coverage(const VoxelGrid &grid, const std::vector<const Light *> &lights,
+                                                    const Vec3 &reference, int samples_per_light = 4096);
+
+}  // namespace neepp

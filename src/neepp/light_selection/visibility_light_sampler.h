@@ -1,0 +1,57 @@
+// NEE++'s visibility-aware light selection (NEEPP.md §3): for a shading point in voxel a, light l is
+// chosen with
+//     p(l | a) = (1 − ε) · w_l(a) · max(Ṽ(a, l), δ) / Σ_k w_k(a) · max(Ṽ(a, k), δ)  +  ε · w_l(a)
+// where w(a) is a base distribution (the spatial estimate, or power) and Ṽ(a, l) the visibility map's
+// estimate between a and the cells light l covers, weighted by how much of the light each holds. Pairs
+// the map has never seen, and a's own voxel, count as visible (the map cannot tell). The defensive ε · w
+// keeps every light the base sampler can pick at a nonzero probability, so a map that is wrong costs
+// variance, never bias. Tables are built lazily per visited voxel from the map frozen for the pass and
+// dropped after each pass, when the map has learned from the pass's shadow rays.
+#pragma once
+#include "neepp/light_selection/light_coverage.h"
+#include "neepp/light_selection/spatial_light_sampler.h"
+#include "neepp/visibility/visibility_map.h"
+
+namespace neepp {
+
+struct VisibilitySelectionOptions {
+    std::string base = "spatial";  // w: "spatial" or "power"
+    float epsilon = 0.1f;          // defensive share of the base distribution
+    float delta = 0.01f;           // floor of Ṽ: a light the map calls occluded keeps some weight
+    SpatialEstimateOptions spatial;
+};
+
+class VisibilityLightSampler final : public LightSampler {
+public:
+    // grid and map must outlive the sampler (they belong to NEE++'s shadow-ray component, which keeps
+    // learning into the map between passes).
+    VisibilityLightSampler(std::vector<const Light *> lights, const VoxelGrid &grid, const VisibilityMap &map,
+                           const Vec3 &reference, VisibilitySelectionOptions options = {});
+    SampledLight sample(const LightSampleContext &ctx, float u) const override {
+        return tables_.sample(grid_.voxel_of(ctx.p), u);
+    }
+    float pmf(const LightSampleContext &ctx, const Light &light) const override {
+        return tables_.pmf(grid_.voxel_of(ctx.p), light);
+    }
+    std::string name() const override { return "visibility"; }
+    void end_pass() override;
+    nlohmann::json statistics() const override;
+
+    // Ṽ(a, l) for the light at position l of the light list: the coverage-weighted map estimate.
+    float light_visibility(uint32_t voxel, size_t l) const;
+
+private:
+    void weights(uint32_t voxel, std::vector<float> &w) const;
+
+    std::vector<const Light *> lights_;
+    const VoxelGrid &grid_;
+    const VisibilityMap &map_;
+    VisibilitySelectionOptions options_;
+    std::vector<std::vector<CellWeight>> coverage_;
+    std::vector<float> power_weights_;            // by position in lights_, normalized
+    std::unique_ptr<VoxelLightTables> spatial_;   // the base w when options_.base == "spatial"; never cleared
+    VoxelLightTables tables_;
+    uint64_t passes_ = 0;
+};
+
+}  // namespace neepp

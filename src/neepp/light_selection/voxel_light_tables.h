@@ -1,0 +1,53 @@
+// Per-voxel light distributions for the spatial and visibility-aware light samplers: one discrete
+// distribution over the scene's lights for every voxel of a grid, built the first time a shading point
+// in that voxel asks (most voxels of a 16³ grid are empty space and never do).
+// Thread safety: get() may be called concurrently during a pass. Two threads that reach an unbuilt voxel
+// at once both build it and one result is kept; since a table depends only on (voxel, state frozen for
+// the pass), both are identical, so the pmf a sample was drawn with is exactly the one pmf() later
+// reports. clear() must only run between passes.
+#pragma once
+#include <atomic>
+#include <functional>
+#include <memory>
+#include <vector>
+#include "neepp/lights/light_sampler.h"
+
+namespace neepp {
+
+class VoxelLightTables {
+public:
+    // Fills weights (one per light, in the order of `lights`, non-negative, at least one positive) for a voxel.
+    using WeightFunction = std::function<void(uint32_t voxel, std::vector<float> &weights)>;
+
+    VoxelLightTables(std::vector<const Light *> lights, uint32_t voxel_count, WeightFunction weights);
+    ~VoxelLightTables();
+    VoxelLightTables(const VoxelLightTables &) = delete;
+    VoxelLightTables &operator=(const VoxelLightTables &) = delete;
+
+    SampledLight sample(uint32_t voxel, float u) const;
+    float pmf(uint32_t voxel, const Light &light) const;
+    // The whole pmf of a voxel, indexed by Light::index (for tests and tools).
+    const std::vector<float> &pmf_table(uint32_t voxel) const { return table(voxel).pmf_by_index; }
+
+    // Drops every table (between passes), so they are rebuilt from the current state.
+    void clear();
+    uint64_t tables_built() const { return built_.load(std::memory_order_relaxed); }
+    uint64_t tables_resident() const;
+    const std::vector<const Light *> &lights() const { return lights_; }
+
+private:
+    struct Table {
+        Distribution1D distribution;      // over lights_ order
+        std::vector<float> pmf_by_index;  // by Light::index, the value both sample() and pmf() report
+    };
+    const Table &table(uint32_t voxel) const;
+
+    std::vector<const Light *> lights_;
+    uint32_t voxel_count_;
+    uint32_t max_index_ = 0;
+    WeightFunction weights_;
+    std::unique_ptr<std::atomic<Table *>[]> tables_;
+    mutable std::atomic<uint64_t> built_{0};
+};
+
+}  // namespace neepp

@@ -1,0 +1,47 @@
+// A many-light scene for the light-selection tests, written inline as Mitsuba XML: a row of rooms along
+// +x joined by doorways, each with its own ceiling light of a different radiance (so power, distance and
+// visibility each favour different lights), the camera in the first room looking down the row.
+#pragma once
+#include <string>
+
+namespace neepp::testing {
+
+inline std::string light_rooms_xml(int rooms = 4, bool environment = false, int width = 24, int height = 18) {
+    const float length = 2.f * float(rooms);
+    std::string xml = R"(<scene version="3.0.0">
+  <integrator type="path"><integer name="max_depth" value="4"/></integrator>
+  <sensor type="perspective">
+    <float name="fov" value="70"/>
+    <transform name="to_world"><lookat origin="0.3,1.1,0.6" target="3,0.8,0" up="0,1,0"/></transform>
+    <film type="hdrfilm"><integer name="width" value=")" + std::to_string(width) + R"("/><integer name="height" value=")" +
+                      std::to_string(height) + R"("/><rfilter type="box"/></film>
+  </sensor>
+  <bsdf type="twosided" id="white"><bsdf type="diffuse"><rgb name="reflectance" value="0.6"/></bsdf></bsdf>
+  <shape type="cube"><transform name="to_world"><scale x=")" + std::to_string(length / 2) + R"(" y="1" z="1"/><translate x=")" +
+                      std::to_string(length / 2) + R"(" y="1"/></transform><ref id="white"/></shape>
+)";
+    if (environment) xml += R"(  <emitter type="constant"><rgb name="radiance" value="0.5"/></emitter>
+)";
+    const char *radiance[] = {"4", "30", "12", "60", "8", "25"};
+    for (int i = 0; i < rooms; ++i) {
+        const std::string cx = std::to_string(2.f * float(i) + 1.f);
+        xml += R"(  <shape type="rectangle"><transform name="to_world"><scale x="0.6" y="0.6"/><rotate x="1" angle="90"/><translate x=")" +
+               cx + R"(" y="1.98"/></transform><ref id="white"/><emitter type="area"><rgb name="radiance" value=")" +
+               radiance[i % 6] + R"("/></emitter></shape>
+)";
+        if (i == 0) continue;
+        // The wall at x = 2i, with a doorway at |z| < 0.3, y < 1.4 (alternating sides so that no line of
+        // sight runs down the whole row).
+        const std::string wx = std::to_string(2.f * float(i));
+        const std::string off = (i % 2) ? "0.35" : "-0.35";
+        const std::string door_z = (i % 2) ? "-0.66" : "0.66";
+        xml += R"(  <shape type="cube"><transform name="to_world"><scale x="0.05" y="1" z="0.675"/><translate x=")" + wx +
+               R"(" y="1" z=")" + off + R"("/></transform><ref id="white"/></shape>
+  <shape type="cube"><transform name="to_world"><scale x="0.05" y="0.3" z="0.345"/><translate x=")" + wx +
+               R"(" y="1.7" z=")" + door_z + R"("/></transform><ref id="white"/></shape>
+)";
+    }
+    return xml + "</scene>\n";
+}
+
+}  // namespace neepp::testing

@@ -1,0 +1,76 @@
+// Every light sampler renders the same image as power sampling on a many-light scene (z-tests on the
+// image mean and coarse blocks over independent seeds, as the NEE++ policy tests do), alone and combined
+// with NEE++'s shadow-ray rejection, with and without an environment light; and the visibility-aware
+// sampler spends its shadow rays on visible lights (fewer occluded rays than power sampling).
+#include <gtest/gtest.h>
+#include <map>
+#include "light_test_scenes.h"
+#include "test_scenes.h"
+
+using namespace neepp;
+using namespace neepp::testing;
+
+namespace {
+
+constexpr int kSeeds = 6;
+constexpr int kSpp = 32;
+
+struct SamplerRun : BlockMoments {
+    uint64_t shadow_rays = 0, occluded = 0;
+};
+
+SamplerRun render_moments(const std::string &path, const std::string &sampler, const std::string &policy, uint64_t seed0) {
+    std::vector<std::vector<double>> per_seed;
+    SamplerRun run;
+    for (int s = 0; s < kSeeds; ++s) {
+        RenderedImage r = render_scene_file(path, kSpp, seed0 + uint64_t(s) * 7919,
+                                            Options(OptionMap{{"light_sampler", sampler}, {"shadow_rays", policy}}));
+        run.shadow_rays += r.result.counters.shadow_rays;
+        run.occluded += r.result.counters.shadow_rays_occluded;
+        per_seed.push_back(block_means(r.image, 6, 6));
+    }
+    static_cast<BlockMoments &>(run) = moments_over_seeds(per_seed);
+    return run;
+}
+
+const std::string &scene_path(bool environment) {
+    static std::string rooms = write_temp_scene(light_rooms_xml(5, false), "rooms.xml");
+    static std::string env = write_temp_scene(light_rooms_xml(5, true), "rooms_env.xml");
+    return environment ? env : rooms;
+}
+
+const SamplerRun &power_reference(bool environment) {
+    static std::map<bool, SamplerRun> cache;
+    auto it = cache.find(environment);
+    if (it == cache.end()) it = cache.emplace(environment, render_moments(scene_path(environment), "power", "nee", 101)).first;
+    return it->second;
+}
+
+class SamplerRender : public ::testing::TestWithParam<std::tuple<std::string, std::string, bool>> {};
+
+TEST_P(SamplerRender, AgreesWithPowerSampling) {
+    const auto &[sampler, policy, env] = GetParam();
+    const SamplerRun &ref = power_reference(env);
+    SamplerRun run = render_moments(scene_path(env), sampler, policy, 5003);
+    expect_same_image(ref, run, sampler + " + " + policy + (env ? " with environment" : ""));
+}
+
+INSTANTIATE_TEST_SUITE_P(LightSelection, SamplerRender,
+                         ::testing::Combine(::testing::Values("uniform", "spatial", "bvh", "visibility", "visibility-power"),
+                                            ::testing::Values("nee", "neepp"), ::testing::Bool()),
+                         [](const auto &info) {
+                             std::string n = std::get<0>(info.param) + "_" + std::get<1>(info.param) +
+                                             (std::get<2>(info.param) ? "_env" : "");
+                             for (char &c : n) if (c == '-') c = '_';
+                             return n;
+                         });
+
+TEST(LightSelectionRender, VisibilitySamplerWastesFewerShadowRays) {
+    const SamplerRun &power = power_reference(false);
+    SamplerRun vis = render_moments(scene_path(false), "visibility", "nee", 101);
+    const double power_occluded = double(power.occluded) / double(power.shadow_rays);
+    const double vis_occluded = double(vis.occluded) / double(vis.shadow_rays);
+    EXPECT_LT(vis_occluded, 0.7 * power_occluded) << "occluded fraction: power " << power_occluded << " visibility " << vis_occluded;
+}
+
+}  // namespace
