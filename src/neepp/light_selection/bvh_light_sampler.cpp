@@ -52,7 +52,7 @@ uint32_t BVHLightSampler::build(std::vector<std::pair<const Light *, LightBounds
     depth_ = std::max(depth_, depth);
     const uint32_t index = uint32_t(nodes_.size());
     if (end - begin == 1) {
-        nodes_.push_back({items[begin].second, items[begin].first->index, true});
+        nodes_.push_back({CompactLightBounds(items[begin].second), items[begin].first->index, true});
         trails_[items[begin].first->index] = {bits, depth};
         return index;
     }
@@ -105,7 +105,7 @@ uint32_t BVHLightSampler::build(std::vector<std::pair<const Light *, LightBounds
     }
     if (mid == begin || mid == end) mid = begin + (end - begin) / 2;
 
-    nodes_.push_back({all, 0, false});
+    nodes_.push_back({CompactLightBounds(all), 0, false});
     build(items, begin, mid, bits, depth + 1);
     const uint32_t second = build(items, mid, end, bits | (uint64_t(1) << depth), depth + 1);
     nodes_[index].child_or_light = second;

@@ -24,7 +24,7 @@ public:
 
 private:
     struct Node {
-        LightBounds bounds;
+        CompactLightBounds bounds;
         uint32_t child_or_light = 0;  // interior: second child (the first is the next node); leaf: light
         bool leaf = false;
     };

@@ -62,14 +62,20 @@ LightBounds bounds_union(const LightBounds &a, const LightBounds &b) {
     return u;
 }
 
-float LightBounds::importance(const Vec3 &p, const Vec3 &n) const {
+float LightBounds::importance(const Vec3 &p, const Vec3 &n) const { return CompactLightBounds(*this).importance(p, n); }
+
+CompactLightBounds::CompactLightBounds(const LightBounds &b)
+    : center(b.bounds.center()), w(b.normals.w), r2(0.25f * squared_norm(b.bounds.extent())),
+      cos_o(b.normals.cos_theta), sin_o(std::sqrt(std::max(0.f, 1.f - b.normals.cos_theta * b.normals.cos_theta))),
+      cos_e(b.cos_theta_e), phi(b.phi), two_sided(b.two_sided) {}
+
+float CompactLightBounds::importance(const Vec3 &p, const Vec3 &n) const {
     if (!(phi > 0)) return 0.f;
-    const Vec3 pc = bounds.center();
-    const float r2 = 0.25f * squared_norm(bounds.extent());  // squared radius of the bounding sphere
-    const float dist2 = squared_norm(p - pc);
-    // Inside (or very near) the bounds the 1/d² falloff means nothing: clamp d² to the bounds' size.
+    const float dist2 = squared_norm(p - center);
+    // Inside (or very near) the bounds the 1/d² falloff means nothing: clamp d² to the bounds' size
+    // (r2: the squared radius of the bounding sphere).
     const float d2 = std::max(dist2, r2);
-    const Vec3 wi = dist2 > 0 ? (p - pc) / std::sqrt(dist2) : Vec3(0, 0, 1);  // from the lights to p
+    const Vec3 wi = dist2 > 0 ? (p - center) / std::sqrt(dist2) : Vec3(0, 0, 1);  // from the lights to p
 
     // Angle subtended by the bounding sphere (theta_b); the whole sphere when p is inside it.
     float cos_b = -1.f, sin_b = 0.f;
@@ -79,20 +85,19 @@ float LightBounds::importance(const Vec3 &p, const Vec3 &n) const {
         cos_b = std::sqrt(std::max(0.f, 1.f - sin2));
     }
     // Emission side: theta' = max(0, theta_w - theta_o - theta_b).
-    float cos_w = dot(normals.w, wi);
+    float cos_w = dot(w, wi);
     if (two_sided) cos_w = std::abs(cos_w);
     const float sin_w = std::sqrt(std::max(0.f, 1.f - cos_w * cos_w));
-    const float cos_o = normals.cos_theta, sin_o = std::sqrt(std::max(0.f, 1.f - cos_o * cos_o));
     float cos_wo, sin_wo, cos_p, sin_p;
     cos_sin_of_clamped_difference(cos_w, sin_w, cos_o, sin_o, cos_wo, sin_wo);
     if (dist2 > r2) cos_sin_of_clamped_difference(cos_wo, sin_wo, cos_b, sin_b, cos_p, sin_p);
     else cos_p = 1.f;
-    if (cos_p <= cos_theta_e) return 0.f;
+    if (cos_p <= cos_e) return 0.f;
     float importance = phi * cos_p / d2;
 
     // Receiver side: the smallest angle between n and a direction toward the bounds. |cos| because the
     // receiver may transmit; a one-sided receiver only makes the bound looser.
-    if (squared_norm(n) > 0 && dist2 > r2) {
+    if (dist2 > r2 && (n.x != 0 || n.y != 0 || n.z != 0)) {
         const float cos_i = std::abs(dot(n, wi));
         const float sin_i = std::sqrt(std::max(0.f, 1.f - cos_i * cos_i));
         float cos_ip, sin_ip;

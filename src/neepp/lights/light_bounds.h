@@ -34,4 +34,14 @@ struct LightBounds {
 
 LightBounds bounds_union(const LightBounds &a, const LightBounds &b);
 
+// LightBounds with what importance() derives from them precomputed, for the BVH's inner loop.
+struct CompactLightBounds {
+    Vec3 center, w;
+    float r2 = 0, cos_o = 1, sin_o = 0, cos_e = 0, phi = 0;
+    bool two_sided = false;
+    CompactLightBounds() = default;
+    explicit CompactLightBounds(const LightBounds &b);
+    float importance(const Vec3 &p, const Vec3 &n) const;
+};
+
 }  // namespace neepp
