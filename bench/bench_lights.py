@@ -12,7 +12,7 @@ of them that were occluded, render time, and ratios to `power`. Equal time gives
 time `power` + `nee` needed at --spp. The summary checks the targets: visibility-aware selection ≥ 20 %
 lower relMSE than the best of uniform/power/spatial at equal time, and not worse than the light BVH.
 
-    .venv/bin/python bench/bench_lights.py                                # all scenes
+    .venv/bin/python bench/bench_lights.py                                # all scenes, ~1 h on 2 cores
     .venv/bin/python bench/bench_lights.py --scenes office --spp 16        # quicker
 
 Writes bench/out/lights/ (git-ignored): report.md, results.json, per-scene comparison figures.
@@ -32,7 +32,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 from bench_neepp import downsample, table  # noqa: E402
 from neepp_tools import REFERENCES, SCENES_DIR, credit, exr, metrics, report, runner  # noqa: E402
 
-SAMPLERS = ["power", "uniform", "spatial", "bvh", "visibility", "visibility-power"]
+SAMPLERS = ["power", "uniform", "spatial", "bvh", "visibility", "visibility-power", "visibility-bvh"]
 MANY_LIGHT_SCENES = ["office", "corridor", "courtyard"]
 BASELINES = ["uniform", "power", "spatial"]
 
@@ -56,7 +56,7 @@ def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--scenes", default=",".join(MANY_LIGHT_SCENES + list(REFERENCES)))
     ap.add_argument("--samplers", default=",".join(SAMPLERS))
-    ap.add_argument("--policies", default="nee,neepp-adaptive", help="shadow-ray policies to combine with")
+    ap.add_argument("--policies", default="nee,neepp,neepp-adaptive", help="shadow-ray policies to combine with")
     ap.add_argument("--spp", type=int, default=64)
     ap.add_argument("--ref-spp", type=int, default=4096, help="Mitsuba reference spp (many-light scenes)")
     ap.add_argument("--scale", type=int, default=4, help="Bitterli scenes: divide the reference resolution")
@@ -115,7 +115,8 @@ def main(argv=None) -> int:
         best = {n: min((r for r in eq if r["sampler"] == n), key=lambda r: r["relMSE"], default=None)
                 for n in samplers}
         base_best = min((best[n] for n in BASELINES if best.get(n)), key=lambda r: r["relMSE"], default=None)
-        vis = min((best[n] for n in ("visibility", "visibility-power") if best.get(n)), key=lambda r: r["relMSE"],
+        vis = min((best[n] for n in ("visibility", "visibility-power", "visibility-bvh") if best.get(n)),
+                  key=lambda r: r["relMSE"],
                   default=None)
         if vis and base_best:
             line = {"scene": scene, "best baseline": f"{base_best['sampler']}+{base_best['policy']}",

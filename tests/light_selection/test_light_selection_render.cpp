@@ -56,7 +56,8 @@ TEST_P(SamplerRender, AgreesWithPowerSampling) {
 }
 
 INSTANTIATE_TEST_SUITE_P(LightSelection, SamplerRender,
-                         ::testing::Combine(::testing::Values("uniform", "spatial", "bvh", "visibility", "visibility-power"),
+                         ::testing::Combine(::testing::Values("uniform", "spatial", "bvh", "visibility", "visibility-power",
+                                                              "visibility-bvh"),
                                             ::testing::Values("nee", "neepp"), ::testing::Bool()),
                          [](const auto &info) {
                              std::string n = std::get<0>(info.param) + "_" + std::get<1>(info.param) +

@@ -117,7 +117,7 @@ float BVHLightSampler::infinite_probability() const {
     return float(infinite_.size()) / float(infinite_.size() + (nodes_.empty() ? 0 : 1));
 }
 
-SampledLight BVHLightSampler::sample(const LightSampleContext &ctx, float u) const {
+SampledLight BVHLightSampler::sample_weighted(const LightSampleContext &ctx, float u, const float *factor) const {
     const float p_inf = infinite_probability();
     if (u < p_inf) {
         u = std::min(u / p_inf, kOneMinusEpsilon);
@@ -130,8 +130,12 @@ SampledLight BVHLightSampler::sample(const LightSampleContext &ctx, float u) con
     uint32_t node = 0;
     while (!nodes_[node].leaf) {
         const uint32_t first = node + 1, second = nodes_[node].child_or_light;
-        const float i0 = nodes_[first].bounds.importance(ctx.p, ctx.n);
-        const float i1 = nodes_[second].bounds.importance(ctx.p, ctx.n);
+        float i0 = nodes_[first].bounds.importance(ctx.p, ctx.n);
+        float i1 = nodes_[second].bounds.importance(ctx.p, ctx.n);
+        if (factor) {
+            i0 *= factor[first];
+            i1 *= factor[second];
+        }
         if (!(i0 > 0) && !(i1 > 0)) return {};
         const float p0 = i0 / (i0 + i1);
         if (u < p0) {
@@ -150,7 +154,7 @@ SampledLight BVHLightSampler::sample(const LightSampleContext &ctx, float u) con
     return {light_by_index_[light], pmf};
 }
 
-float BVHLightSampler::pmf(const LightSampleContext &ctx, const Light &light) const {
+float BVHLightSampler::pmf_weighted(const LightSampleContext &ctx, const Light &light, const float *factor) const {
     if (light.index >= trails_.size()) return 0.f;
     const float p_inf = infinite_probability();
     if (is_infinite_[light.index]) return p_inf / float(infinite_.size());
@@ -160,8 +164,12 @@ float BVHLightSampler::pmf(const LightSampleContext &ctx, const Light &light) co
     uint32_t node = 0;
     for (int d = 0; d < trail.length; ++d) {
         const uint32_t first = node + 1, second = nodes_[node].child_or_light;
-        const float i0 = nodes_[first].bounds.importance(ctx.p, ctx.n);
-        const float i1 = nodes_[second].bounds.importance(ctx.p, ctx.n);
+        float i0 = nodes_[first].bounds.importance(ctx.p, ctx.n);
+        float i1 = nodes_[second].bounds.importance(ctx.p, ctx.n);
+        if (factor) {
+            i0 *= factor[first];
+            i1 *= factor[second];
+        }
         if (!(i0 > 0) && !(i1 > 0)) return 0.f;
         const float p0 = i0 / (i0 + i1);
         if ((trail.bits >> d) & 1) {

@@ -14,12 +14,24 @@ namespace neepp {
 class BVHLightSampler final : public LightSampler {
 public:
     explicit BVHLightSampler(std::vector<const Light *> lights);
-    SampledLight sample(const LightSampleContext &ctx, float u) const override;
-    float pmf(const LightSampleContext &ctx, const Light &light) const override;
+    SampledLight sample(const LightSampleContext &ctx, float u) const override { return sample_weighted(ctx, u, nullptr); }
+    float pmf(const LightSampleContext &ctx, const Light &light) const override { return pmf_weighted(ctx, light, nullptr); }
     std::string name() const override { return "bvh"; }
     nlohmann::json statistics() const override;
 
+    // The same descent with each node's importance multiplied by factor[node] (> 0; null: all 1), the
+    // hook through which visibility reweights the tree (VisibilityBVHLightSampler). For a given factor
+    // array the pmf sample_weighted reports is bit-identical to pmf_weighted's.
+    SampledLight sample_weighted(const LightSampleContext &ctx, float u, const float *factor) const;
+    float pmf_weighted(const LightSampleContext &ctx, const Light &light, const float *factor) const;
+
+    // The tree, for building per-node factors: nodes in depth-first order (a node's first child follows
+    // it, so children always come after their parent).
     size_t node_count() const { return nodes_.size(); }
+    bool is_leaf(uint32_t node) const { return nodes_[node].leaf; }
+    uint32_t second_child(uint32_t node) const { return nodes_[node].child_or_light; }
+    const Light &leaf_light(uint32_t node) const { return *light_by_index_[nodes_[node].child_or_light]; }
+    float node_power(uint32_t node) const { return nodes_[node].bounds.phi; }
     int depth() const { return depth_; }
 
 private:

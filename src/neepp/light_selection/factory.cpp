@@ -3,18 +3,20 @@
 #include <stdexcept>
 #include "neepp/light_selection/bvh_light_sampler.h"
 #include "neepp/light_selection/spatial_light_sampler.h"
+#include "neepp/light_selection/visibility_bvh_light_sampler.h"
 #include "neepp/light_selection/visibility_light_sampler.h"
 #include "neepp/scene/scene.h"
 
 namespace neepp {
 
 const std::vector<std::string> &light_sampler_names() {
-    static const std::vector<std::string> names = {"uniform", "power", "spatial", "bvh", "visibility", "visibility-power"};
+    static const std::vector<std::string> names = {"uniform", "power", "spatial", "bvh", "visibility", "visibility-power",
+                                                    "visibility-bvh"};
     return names;
 }
 
 bool light_sampler_needs_visibility_map(const std::string &name) {
-    return name == "visibility" || name == "visibility-power";
+    return name == "visibility" || name == "visibility-power" || name == "visibility-bvh";
 }
 
 std::unique_ptr<LightSampler> make_light_sampler(const std::string &name, std::vector<const Light *> lights,
@@ -29,9 +31,11 @@ std::unique_ptr<LightSampler> make_light_sampler(const std::string &name, std::v
     }
     if (light_sampler_needs_visibility_map(name)) {
         if (!in.grid || !in.map) throw std::invalid_argument("light sampler '" + name + "' needs NEE++'s visibility map");
+        const Vec3 reference = in.scene ? in.scene->bounds().center() : in.grid->bounds().center();
+        if (name == "visibility-bvh")
+            return std::make_unique<VisibilityBVHLightSampler>(std::move(lights), *in.grid, *in.map, reference);
         VisibilitySelectionOptions o;
         o.base = name == "visibility" ? "spatial" : "power";
-        const Vec3 reference = in.scene ? in.scene->bounds().center() : in.grid->bounds().center();
         return std::make_unique<VisibilityLightSampler>(std::move(lights), *in.grid, *in.map, reference, o);
     }
     std::string list;

@@ -1,5 +1,5 @@
 // Creates light samplers by name: uniform, power, spatial, bvh, visibility (NEE++ over the spatial
-// estimate) and visibility-power (NEE++ over power).
+// estimate), visibility-power (NEE++ over power) and visibility-bvh (the light BVH reweighted by NEE++).
 #pragma once
 #include <memory>
 #include <string>

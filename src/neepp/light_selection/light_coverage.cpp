@@ -1,6 +1,7 @@
 #include "neepp/light_selection/light_coverage.h"
 
 #include <map>
+#include <stdexcept>
 #include "neepp/sampling/rng.h"
 
 namespace neepp {
@@ -27,6 +28,34 @@ std::vector<std::vector<CellWeight>> light_coverage(const VoxelGrid &grid, const
         for (auto [cell, n] : counts) coverage[l].push_back({cell, float(n) / float(total)});
     }
     return coverage;
+}
+
+LightVisibility::LightVisibility(const VoxelGrid &grid, const VisibilityMap &map, const std::vector<const Light *> &lights,
+                                 const Vec3 &reference)
+    : map_(map) {
+    if (map.cell_count() != grid.cell_count()) throw std::invalid_argument("light visibility: map and grid disagree");
+    auto by_position = light_coverage(grid, lights, reference);
+    for (size_t i = 0; i < lights.size(); ++i) {
+        if (lights[i]->index >= coverage_.size()) coverage_.resize(lights[i]->index + 1);
+        coverage_[lights[i]->index] = std::move(by_position[i]);
+    }
+}
+
+float LightVisibility::operator()(uint32_t voxel, const Light &light) const {
+    if (light.index >= coverage_.size()) return 1.f;
+    double v = 0;
+    for (const CellWeight &cw : coverage_[light.index]) {
+        const PairCounts c = map_.counts(voxel, cw.cell);
+        const bool unknown = c.traced == 0 || cw.cell == voxel;
+        v += double(cw.weight) * (unknown ? 1.0 : double(VisibilityMap::estimate(c)));
+    }
+    return float(v);
+}
+
+uint64_t LightVisibility::covered_cells() const {
+    uint64_t n = 0;
+    for (auto &c : coverage_) n += c.size();
+    return n;
 }
 
 }  // namespace neepp

@@ -5,6 +5,7 @@
 #pragma once
 #include <vector>
 #include "neepp/lights/light.h"
+#include "neepp/visibility/visibility_map.h"
 #include "neepp/visibility/voxel_grid.h"
 
 namespace neepp {
@@ -18,5 +19,21 @@ struct CellWeight {
 // matters for lights whose sampling depends on it: their visible part is what counts from there).
 std::vector<std::vector<CellWeight>> light_coverage(const VoxelGrid &grid, const std::vector<const Light *> &lights,
                                                     const Vec3 &reference, int samples_per_light = 4096);
+
+// Ṽ(a, l): the visibility map's estimate between voxel a and light l, i.e. the coverage-weighted mean of
+// Ṽ(a, b) over the cells b that l covers. Pairs the map has never seen, and a's own voxel (whose
+// visibility the map cannot resolve), count as visible. Lights are addressed by Light::index.
+class LightVisibility {
+public:
+    // map must outlive this object (it keeps learning between passes; values follow it).
+    LightVisibility(const VoxelGrid &grid, const VisibilityMap &map, const std::vector<const Light *> &lights,
+                    const Vec3 &reference);
+    float operator()(uint32_t voxel, const Light &light) const;
+    uint64_t covered_cells() const;
+
+private:
+    const VisibilityMap &map_;
+    std::vector<std::vector<CellWeight>> coverage_;  // by Light::index
+};
 
 }  // namespace neepp

@@ -37,17 +37,13 @@ public:
     void end_pass() override;
     nlohmann::json statistics() const override;
 
-    // Ṽ(a, l) for the light at position l of the light list: the coverage-weighted map estimate.
-    float light_visibility(uint32_t voxel, size_t l) const;
-
 private:
     void weights(uint32_t voxel, std::vector<float> &w) const;
 
     std::vector<const Light *> lights_;
     const VoxelGrid &grid_;
-    const VisibilityMap &map_;
     VisibilitySelectionOptions options_;
-    std::vector<std::vector<CellWeight>> coverage_;
+    LightVisibility visibility_;
     std::vector<float> power_weights_;            // by position in lights_, normalized
     std::unique_ptr<VoxelLightTables> spatial_;   // the base w when options_.base == "spatial"; never cleared
     VoxelLightTables tables_;

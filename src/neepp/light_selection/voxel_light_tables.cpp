@@ -6,26 +6,11 @@
 namespace neepp {
 
 VoxelLightTables::VoxelLightTables(std::vector<const Light *> lights, uint32_t voxel_count, WeightFunction weights)
-    : lights_(std::move(lights)), voxel_count_(voxel_count), weights_(std::move(weights)),
-      tables_(new std::atomic<Table *>[voxel_count]) {
+    : lights_(std::move(lights)), weights_(std::move(weights)), tables_(voxel_count) {
     for (const Light *l : lights_) max_index_ = std::max(max_index_, l->index);
-    for (uint32_t v = 0; v < voxel_count_; ++v) tables_[v].store(nullptr, std::memory_order_relaxed);
 }
 
-VoxelLightTables::~VoxelLightTables() { clear(); }
-
-void VoxelLightTables::clear() {
-    for (uint32_t v = 0; v < voxel_count_; ++v) delete tables_[v].exchange(nullptr);
-}
-
-uint64_t VoxelLightTables::tables_resident() const {
-    uint64_t n = 0;
-    for (uint32_t v = 0; v < voxel_count_; ++v) n += tables_[v].load(std::memory_order_relaxed) != nullptr;
-    return n;
-}
-
-const VoxelLightTables::Table &VoxelLightTables::table(uint32_t voxel) const {
-    if (Table *t = tables_[voxel].load(std::memory_order_acquire)) return *t;
+std::unique_ptr<VoxelLightTables::Table> VoxelLightTables::build(uint32_t voxel) const {
     std::vector<float> w(lights_.size(), 0.f);
     weights_(voxel, w);
     double total = 0;
@@ -34,16 +19,15 @@ const VoxelLightTables::Table &VoxelLightTables::table(uint32_t voxel) const {
         total += x;
     }
     if (!(total > 0)) throw std::logic_error("light table without a positive weight");
-    auto fresh = std::make_unique<Table>();
-    fresh->distribution = Distribution1D(w);
-    fresh->pmf_by_index.assign(lights_.empty() ? 0 : max_index_ + 1, 0.f);
-    for (size_t i = 0; i < lights_.size(); ++i) fresh->pmf_by_index[lights_[i]->index] = fresh->distribution.pmf(uint32_t(i));
-    Table *expected = nullptr;
-    if (tables_[voxel].compare_exchange_strong(expected, fresh.get(), std::memory_order_acq_rel)) {
-        built_.fetch_add(1, std::memory_order_relaxed);
-        return *fresh.release();
-    }
-    return *expected;  // another thread built the same table first
+    auto t = std::make_unique<Table>();
+    t->distribution = Distribution1D(w);
+    t->pmf_by_index.assign(lights_.empty() ? 0 : max_index_ + 1, 0.f);
+    for (size_t i = 0; i < lights_.size(); ++i) t->pmf_by_index[lights_[i]->index] = t->distribution.pmf(uint32_t(i));
+    return t;
+}
+
+const VoxelLightTables::Table &VoxelLightTables::table(uint32_t voxel) const {
+    return tables_.get(voxel, [this](uint32_t v) { return build(v); });
 }
 
 SampledLight VoxelLightTables::sample(uint32_t voxel, float u) const {

@@ -1,15 +1,12 @@
 // Per-voxel light distributions for the spatial and visibility-aware light samplers: one discrete
 // distribution over the scene's lights for every voxel of a grid, built the first time a shading point
 // in that voxel asks (most voxels of a 16³ grid are empty space and never do).
-// Thread safety: get() may be called concurrently during a pass. Two threads that reach an unbuilt voxel
-// at once both build it and one result is kept; since a table depends only on (voxel, state frozen for
-// the pass), both are identical, so the pmf a sample was drawn with is exactly the one pmf() later
-// reports. clear() must only run between passes.
+// Thread safety as LazyVoxelArray: since a table depends only on (voxel, state frozen for the pass), the
+// pmf a sample was drawn with is exactly the one pmf() later reports. clear() only between passes.
 #pragma once
-#include <atomic>
 #include <functional>
-#include <memory>
 #include <vector>
+#include "neepp/light_selection/lazy_voxel_array.h"
 #include "neepp/lights/light_sampler.h"
 
 namespace neepp {
@@ -20,9 +17,6 @@ public:
     using WeightFunction = std::function<void(uint32_t voxel, std::vector<float> &weights)>;
 
     VoxelLightTables(std::vector<const Light *> lights, uint32_t voxel_count, WeightFunction weights);
-    ~VoxelLightTables();
-    VoxelLightTables(const VoxelLightTables &) = delete;
-    VoxelLightTables &operator=(const VoxelLightTables &) = delete;
 
     SampledLight sample(uint32_t voxel, float u) const;
     float pmf(uint32_t voxel, const Light &light) const;
@@ -30,9 +24,8 @@ public:
     const std::vector<float> &pmf_table(uint32_t voxel) const { return table(voxel).pmf_by_index; }
 
     // Drops every table (between passes), so they are rebuilt from the current state.
-    void clear();
-    uint64_t tables_built() const { return built_.load(std::memory_order_relaxed); }
-    uint64_t tables_resident() const;
+    void clear() { tables_.clear(); }
+    uint64_t tables_built() const { return tables_.built(); }
     const std::vector<const Light *> &lights() const { return lights_; }
 
 private:
@@ -41,13 +34,12 @@ private:
         std::vector<float> pmf_by_index;  // by Light::index, the value both sample() and pmf() report
     };
     const Table &table(uint32_t voxel) const;
+    std::unique_ptr<Table> build(uint32_t voxel) const;
 
     std::vector<const Light *> lights_;
-    uint32_t voxel_count_;
     uint32_t max_index_ = 0;
     WeightFunction weights_;
-    std::unique_ptr<std::atomic<Table *>[]> tables_;
-    mutable std::atomic<uint64_t> built_{0};
+    LazyVoxelArray<Table> tables_;
 };
 
 }  // namespace neepp
