@@ -35,6 +35,13 @@ from neepp_tools import REFERENCES, SCENES_DIR, credit, exr, metrics, report, ru
 SAMPLERS = ["power", "uniform", "spatial", "bvh", "visibility", "visibility-power", "visibility-bvh"]
 MANY_LIGHT_SCENES = ["office", "corridor", "courtyard"]
 BASELINES = ["uniform", "power", "spatial"]
+SUMMARY_NOTE = """
+"vis / baseline": relMSE of the best visibility-aware sampler over the best of uniform/power/spatial,
+each with its best shadow-ray policy, at equal time (target ≤ 0.8); "vis / bvh": over the light BVH
+(target ≤ 1). The "from equal spp" columns estimate the same ratios as relMSE × render time. With one
+light every sampler is power (identical images at equal spp): their equal-time differences are timing
+noise, and show how large that noise is on this machine.
+"""
 
 
 def scene_setup(scene, a):
@@ -52,6 +59,52 @@ def scene_setup(scene, a):
     return xml, w, h, a.max_depth, ref.image, f"Mitsuba 3 llvm_ad_rgb, {a.ref_spp} spp", []
 
 
+VISIBILITY = ["visibility", "visibility-power", "visibility-bvh"]
+
+
+def summary_line(scene: str, result: dict) -> dict | None:
+    """The targets' comparison for one scene, over every sampler × policy combination: the best
+    visibility-aware sampler against the best baseline and against the BVH, at equal time, and the same
+    estimated from the equal-spp runs as relMSE × render time (free of a time-limited run's whole-pass
+    granularity, not of timing noise)."""
+    def best(mode, key):
+        rows = [r | {"policy": p, "relMSE x time": r["relMSE"] * r["render_s"]}
+                for p, rs in result.get(mode, {}).items() for r in rs]
+        out = {}
+        for r in rows:
+            if r["sampler"] not in out or r[key] < out[r["sampler"]][key]:
+                out[r["sampler"]] = r
+        return out
+
+    def pick(b, names, key):
+        return min((b[n] for n in names if n in b), key=lambda r: r[key], default=None)
+
+    et, es = best("equal_time", "relMSE"), best("equal_spp", "relMSE x time")
+    base, vis = pick(et, BASELINES, "relMSE"), pick(et, VISIBILITY, "relMSE")
+    if not base or not vis:
+        return None
+    line = {"scene": scene, "best baseline": f"{base['sampler']}+{base['policy']}", "baseline relMSE": base["relMSE"],
+            "best visibility": f"{vis['sampler']}+{vis['policy']}", "visibility relMSE": vis["relMSE"],
+            "vis / baseline": vis["relMSE"] / base["relMSE"]}
+    if "bvh" in et:
+        line["bvh relMSE"] = et["bvh"]["relMSE"]
+        line["vis / bvh"] = vis["relMSE"] / et["bvh"]["relMSE"]
+    e_base, e_vis = pick(es, BASELINES, "relMSE x time"), pick(es, VISIBILITY, "relMSE x time")
+    line["from equal spp: vis / baseline"] = e_vis["relMSE x time"] / e_base["relMSE x time"]
+    if "bvh" in es:
+        line["from equal spp: vis / bvh"] = e_vis["relMSE x time"] / es["bvh"]["relMSE x time"]
+    return line
+
+
+def summarize(paths) -> str:
+    """Summary table of one or more results.json files (e.g. of runs over different scene sets)."""
+    lines = []
+    for path in paths:
+        data = json.loads(Path(path).read_text())
+        lines += [summary_line(scene, r) for scene, r in data["scenes"].items()]
+    return table([x for x in lines if x]) + "\n" + SUMMARY_NOTE
+
+
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--scenes", default=",".join(MANY_LIGHT_SCENES + list(REFERENCES)))
@@ -65,7 +118,12 @@ def main(argv=None) -> int:
     ap.add_argument("--seed", type=int, default=1)
     ap.add_argument("--scenes-dir", default=str(SCENES_DIR))
     ap.add_argument("--out", default=str(REPO / "bench" / "out" / "lights"))
+    ap.add_argument("--summarize", nargs="+", metavar="RESULTS_JSON",
+                    help="only print the summary table of earlier runs' results.json files")
     a = ap.parse_args(argv)
+    if a.summarize:
+        print(summarize(a.summarize))
+        return 0
     samplers, policies = a.samplers.split(","), a.policies.split(",")
     out = Path(a.out)
     out.mkdir(parents=True, exist_ok=True)
@@ -93,6 +151,7 @@ def main(argv=None) -> int:
                     kw = {"spp": a.spp} if mode == "equal_spp" else {"time_s": budget}
                     r = render(sampler, policy, f"{mode}_{policy}_{sampler}.exr", **kw)
                     s = r.stats
+                    lights = s.get("lights")
                     row = {"sampler": sampler, "spp": s["spp"], "relMSE": metrics.relmse(r.image, ref),
                            "shadow_rays": s["shadow_rays"],
                            "occluded": s.get("shadow_rays_occluded", 0) / max(1, s["shadow_rays"]),
@@ -110,25 +169,12 @@ def main(argv=None) -> int:
                 md.append(f"\n### {title}, shadow rays: {policy}\n\n" + table(rows) + "\n")
                 report.comparison_figure(out / scene / f"compare_{mode}_{policy}.png", images, ref=ref,
                                          title=f"{scene}: {title}, {policy}", credit=credit(scene))
-        # Targets at equal time, over every policy combination.
-        eq = [r | {"policy": p} for p, rows in results[scene]["equal_time"].items() for r in rows]
-        best = {n: min((r for r in eq if r["sampler"] == n), key=lambda r: r["relMSE"], default=None)
-                for n in samplers}
-        base_best = min((best[n] for n in BASELINES if best.get(n)), key=lambda r: r["relMSE"], default=None)
-        vis = min((best[n] for n in ("visibility", "visibility-power", "visibility-bvh") if best.get(n)),
-                  key=lambda r: r["relMSE"],
-                  default=None)
-        if vis and base_best:
-            line = {"scene": scene, "best baseline": f"{base_best['sampler']}+{base_best['policy']}",
-                    "baseline relMSE": base_best["relMSE"], "best visibility": f"{vis['sampler']}+{vis['policy']}",
-                    "visibility relMSE": vis["relMSE"], "vis / baseline": vis["relMSE"] / base_best["relMSE"]}
-            if best.get("bvh"):
-                line["bvh relMSE"] = best["bvh"]["relMSE"]
-                line["vis / bvh"] = vis["relMSE"] / best["bvh"]["relMSE"]
-            summary.append(line)
+        line = summary_line(scene, results[scene])
+        if line:
+            summary.append(line | {"lights": lights})
         (out / "results.json").write_text(json.dumps({"scenes": results, "summary": summary}, indent=2))
         (out / "report.md").write_text("".join(md) + "\n## Summary (equal time, best policy per sampler)\n\n" +
-                                       (table(summary) if summary else "") + "\n")
+                                       (table(summary) if summary else "") + "\n" + SUMMARY_NOTE)
     print((out / "report.md").read_text())
     return 0
 
