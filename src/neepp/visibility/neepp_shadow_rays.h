@@ -108,6 +108,7 @@ private:
     void calibrate_adaptive(const std::vector<uint64_t> &histogram, uint64_t roulettes, uint64_t paper_q_sum_fixed);
 
     NeeppOptions options_;
+    bool ray_budget_;  // adaptive policy calibrated to the paper's ray budget (needs the histogram)
     VoxelGrid grid_;
     VisibilityMap map_;
     bool adopted_ = false;
