@@ -32,13 +32,14 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 from bench_neepp import downsample, table  # noqa: E402
 from neepp_tools import REFERENCES, SCENES_DIR, credit, exr, metrics, report, runner  # noqa: E402
 
-SAMPLERS = ["power", "uniform", "spatial", "bvh", "visibility", "visibility-power", "visibility-bvh"]
+SAMPLERS = ["power", "uniform", "spatial", "spatial-oriented", "bvh", "visibility", "visibility-power", "visibility-bvh"]
 MANY_LIGHT_SCENES = ["office", "corridor", "courtyard"]
 BASELINES = ["uniform", "power", "spatial"]
 SUMMARY_NOTE = """
 "vis / baseline": relMSE of the best visibility-aware sampler over the best of uniform/power/spatial,
 each with its best shadow-ray policy, at equal time (target ≤ 0.8); "vis / bvh": over the light BVH
-(target ≤ 1). The "from equal spp" columns estimate the same ratios as relMSE × render time. With one
+(target ≤ 1); "vis / spatial-oriented": over the spatial estimate with the same orientation-aware
+tables as `visibility` (ours; what the map adds on top of orientation). The "from equal spp" columns estimate the same ratios as relMSE × render time. With one
 light every sampler is power (identical images at equal spp): their equal-time differences are timing
 noise, and show how large that noise is on this machine.
 """
@@ -89,6 +90,8 @@ def summary_line(scene: str, result: dict) -> dict | None:
     if "bvh" in et:
         line["bvh relMSE"] = et["bvh"]["relMSE"]
         line["vis / bvh"] = vis["relMSE"] / et["bvh"]["relMSE"]
+    if "spatial-oriented" in et:  # ours: what orientation alone buys, without visibility
+        line["vis / spatial-oriented"] = vis["relMSE"] / et["spatial-oriented"]["relMSE"]
     e_base, e_vis = pick(es, BASELINES, "relMSE x time"), pick(es, VISIBILITY, "relMSE x time")
     line["from equal spp: vis / baseline"] = e_vis["relMSE x time"] / e_base["relMSE x time"]
     if "bvh" in es:

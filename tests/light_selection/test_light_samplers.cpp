@@ -134,7 +134,7 @@ TEST_P(EverySampler, EveryLightThatCanContributeKeepsAProbability) {
 }
 
 INSTANTIATE_TEST_SUITE_P(LightSelection, EverySampler,
-                         ::testing::Combine(::testing::Values("uniform", "power", "spatial", "bvh", "visibility",
+                         ::testing::Combine(::testing::Values("uniform", "power", "spatial", "spatial-oriented", "bvh", "visibility",
                                                               "visibility-power", "visibility-bvh"),
                                             ::testing::Bool()),
                          [](const auto &info) {
@@ -147,7 +147,7 @@ TEST(LightSelection, LazyTablesDoNotDependOnTheBuildingThread) {
     const Fixture &f = fixture(true);
     auto contexts = f.contexts(2000, 31);
     auto lights = f.scene->light_pointers();
-    for (const char *name : {"spatial", "visibility", "visibility-bvh"}) {
+    for (const char *name : {"spatial", "spatial-oriented", "visibility", "visibility-bvh"}) {
         auto serial = f.make(name), parallel = f.make(name);
         std::vector<float> a(contexts.size() * lights.size()), b(a.size());
         for (size_t i = 0; i < contexts.size(); ++i)

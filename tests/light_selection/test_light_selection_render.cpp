@@ -56,7 +56,7 @@ TEST_P(SamplerRender, AgreesWithPowerSampling) {
 }
 
 INSTANTIATE_TEST_SUITE_P(LightSelection, SamplerRender,
-                         ::testing::Combine(::testing::Values("uniform", "spatial", "bvh", "visibility", "visibility-power",
+                         ::testing::Combine(::testing::Values("uniform", "spatial", "spatial-oriented", "bvh", "visibility", "visibility-power",
                                                               "visibility-bvh"),
                                             ::testing::Values("nee", "neepp"), ::testing::Bool()),
                          [](const auto &info) {

@@ -25,7 +25,7 @@ std::unique_ptr<Integrator> make_integrator(const std::string &name, const Optio
         // that reads the map), so a typo'd or meaningless option is still reported as unused.
         std::string policy = options.get_string("shadow_rays", "nee");
         const bool needs_map = light_sampler_needs_visibility_map(o.light_sampler);
-        if (o.light_sampler == "spatial" || needs_map || policy != "nee") o.voxels = options.get_int("voxels", o.voxels);
+        if (o.light_sampler.rfind("spatial", 0) == 0 || needs_map || policy != "nee") o.voxels = options.get_int("voxels", o.voxels);
         std::unique_ptr<ShadowRayTester> shadow;
         if (policy == "nee" && !needs_map) {
             shadow = std::make_unique<TraceAllShadowRays>();

@@ -8,6 +8,15 @@
 
 namespace neepp {
 
+namespace {
+// The light-selection context of a scattering vertex: its normal turned toward the side the path
+// arrived from (the side it gathers light on), so that orientation-aware samplers see which way it
+// faces. Used both where lights are sampled and where MIS asks for the pmf, so the two agree.
+LightSampleContext light_context(const SurfaceInteraction &si) {
+    return {si.p, dot(si.to_world(si.wi), si.n) < 0 ? -si.n : si.n};
+}
+}  // namespace
+
 PathIntegrator::PathIntegrator(PathOptions options, std::unique_ptr<ShadowRayTester> shadow)
     : options_(std::move(options)), shadow_(std::move(shadow)) {}
 
@@ -58,7 +67,7 @@ float PathIntegrator::emission_weight(const Light &light, const LightSampleConte
 
 Color PathIntegrator::sample_direct(const Scene &scene, const SurfaceInteraction &si, const BSDF &bsdf,
                                     const Color &beta, Sampler &sampler, RenderCounters &counters) const {
-    LightSampleContext ctx{si.p, si.n};
+    LightSampleContext ctx = light_context(si);
     SampledLight sl = light_sampler_->sample(ctx, sampler.next_1d());
     Vec2 u = sampler.next_2d();
     if (!sl.light || sl.pmf <= 0) return Color(0.f);
@@ -123,7 +132,7 @@ Color PathIntegrator::Li(const Scene &scene, const Ray &primary, Sampler &sample
         if (!bs.valid()) break;
         beta *= bs.weight;
         eta *= bs.eta;
-        prev = LightSampleContext{si.p, si.n};
+        prev = light_context(si);
         prev_bsdf_pdf = bs.pdf;
         prev_delta = (bs.sampled_flags & BSDFDelta) != 0;
         ray = si.spawn_ray(si.to_world(bs.wo));

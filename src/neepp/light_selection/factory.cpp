@@ -10,8 +10,8 @@
 namespace neepp {
 
 const std::vector<std::string> &light_sampler_names() {
-    static const std::vector<std::string> names = {"uniform", "power", "spatial", "bvh", "visibility", "visibility-power",
-                                                    "visibility-bvh"};
+    static const std::vector<std::string> names = {"uniform", "power", "spatial", "spatial-oriented", "bvh",
+                                                    "visibility", "visibility-power", "visibility-bvh"};
     return names;
 }
 
@@ -24,10 +24,12 @@ std::unique_ptr<LightSampler> make_light_sampler(const std::string &name, std::v
     if (name == "uniform") return std::make_unique<UniformLightSampler>(std::move(lights));
     if (name == "power") return std::make_unique<PowerLightSampler>(std::move(lights));
     if (name == "bvh") return std::make_unique<BVHLightSampler>(std::move(lights));
-    if (name == "spatial") {
-        if (in.grid) return std::make_unique<SpatialLightSampler>(std::move(lights), *in.grid);
+    if (name == "spatial" || name == "spatial-oriented") {
+        SpatialEstimateOptions o;
+        o.oriented = name == "spatial-oriented";
+        if (in.grid) return std::make_unique<SpatialLightSampler>(std::move(lights), *in.grid, o);
         if (!in.scene) throw std::invalid_argument("the spatial light sampler needs a scene or a grid");
-        return std::make_unique<SpatialLightSampler>(std::move(lights), VoxelGrid(in.scene->bounds(), in.voxels));
+        return std::make_unique<SpatialLightSampler>(std::move(lights), VoxelGrid(in.scene->bounds(), in.voxels), o);
     }
     if (light_sampler_needs_visibility_map(name)) {
         if (!in.grid || !in.map) throw std::invalid_argument("light sampler '" + name + "' needs NEE++'s visibility map");

@@ -13,27 +13,40 @@ namespace neepp {
 struct SpatialEstimateOptions {
     int points_per_voxel = 16;    // stratified points inside the voxel, one light sample each per light
     float power_fraction = 0.1f;  // defensive share of power sampling
+    bool oriented = false;        // tables per (voxel, receiver orientation bucket), see normal_bucket()
 };
 
+// Receiver orientation classes, for tables that also know which way the shading point faces: the
+// dominant axis of its normal (face-forwarded toward the side light is gathered on), 6 classes, plus one
+// for "no normal". A class is a pure function of the normal, so the pmf stays exactly reproducible.
+constexpr uint32_t kNormalBuckets = 7;
+uint32_t normal_bucket(const Vec3 &n);
+
 // Fills one weight per light (in `lights` order) with the voxel's normalized spatial estimate mixed with
-// power: (1 − f) · s_l / Σs + f · P_l / ΣP. Deterministic in (grid, voxel, lights).
-void spatial_light_weights(const VoxelGrid &grid, uint32_t voxel, const std::vector<const Light *> &lights,
+// power: (1 − f) · s_l / Σs + f · P_l / ΣP. Deterministic in (grid, voxel, bucket, lights). With an
+// orientation bucket (< 6) each light sample counts (0.1 + 0.9·max(0, cos)) times, cos taken with the
+// bucket's axis: lights behind a receiver weigh less (never zero: the bucket is only a dominant axis).
+void spatial_light_weights(const VoxelGrid &grid, uint32_t voxel, uint32_t bucket, const std::vector<const Light *> &lights,
                            const SpatialEstimateOptions &options, std::vector<float> &weights);
 
 class SpatialLightSampler final : public LightSampler {
 public:
+    // Unoriented: the paper's baseline ("spatial"); oriented: ours ("spatial-oriented"), to tell apart
+    // what orientation and what visibility buy in the visibility sampler, which uses oriented tables.
     SpatialLightSampler(std::vector<const Light *> lights, const VoxelGrid &grid, SpatialEstimateOptions options = {});
-    SampledLight sample(const LightSampleContext &ctx, float u) const override {
-        return tables_.sample(grid_.voxel_of(ctx.p), u);
-    }
-    float pmf(const LightSampleContext &ctx, const Light &light) const override {
-        return tables_.pmf(grid_.voxel_of(ctx.p), light);
-    }
-    std::string name() const override { return "spatial"; }
+    SampledLight sample(const LightSampleContext &ctx, float u) const override { return tables_.sample(key(ctx), u); }
+    float pmf(const LightSampleContext &ctx, const Light &light) const override { return tables_.pmf(key(ctx), light); }
+    std::string name() const override { return oriented_ ? "spatial-oriented" : "spatial"; }
     nlohmann::json statistics() const override;
 
 private:
+    uint32_t key(const LightSampleContext &ctx) const {
+        const uint32_t v = grid_.voxel_of(ctx.p);
+        return oriented_ ? v * kNormalBuckets + normal_bucket(ctx.n) : v;
+    }
+
     VoxelGrid grid_;
+    bool oriented_;
     VoxelLightTables tables_;
 };
 

@@ -19,6 +19,9 @@ struct VisibilitySelectionOptions {
     float epsilon = 0.1f;          // defensive share of the base distribution
     float delta = 0.01f;           // floor of Ṽ: a light the map calls occluded keeps some weight
     SpatialEstimateOptions spatial;
+    // Tables per (voxel, receiver orientation) rather than per voxel (spatial base only): lights behind
+    // the shading point's surface weigh less. Ours, beyond the paper.
+    bool oriented = true;
 };
 
 class VisibilityLightSampler final : public LightSampler {
@@ -27,22 +30,24 @@ public:
     // learning into the map between passes).
     VisibilityLightSampler(std::vector<const Light *> lights, const VoxelGrid &grid, const VisibilityMap &map,
                            const Vec3 &reference, VisibilitySelectionOptions options = {});
-    SampledLight sample(const LightSampleContext &ctx, float u) const override {
-        return tables_.sample(grid_.voxel_of(ctx.p), u);
-    }
-    float pmf(const LightSampleContext &ctx, const Light &light) const override {
-        return tables_.pmf(grid_.voxel_of(ctx.p), light);
-    }
+    SampledLight sample(const LightSampleContext &ctx, float u) const override { return tables_.sample(key(ctx), u); }
+    float pmf(const LightSampleContext &ctx, const Light &light) const override { return tables_.pmf(key(ctx), light); }
     std::string name() const override { return "visibility"; }
     void end_pass() override;
     nlohmann::json statistics() const override;
 
 private:
-    void weights(uint32_t voxel, std::vector<float> &w) const;
+    // The table a shading point reads: its voxel, and its orientation bucket when tables are oriented.
+    uint32_t key(const LightSampleContext &ctx) const {
+        const uint32_t v = grid_.voxel_of(ctx.p);
+        return oriented_ ? v * kNormalBuckets + normal_bucket(ctx.n) : v;
+    }
+    void weights(uint32_t key, std::vector<float> &w) const;
 
     std::vector<const Light *> lights_;
     const VoxelGrid &grid_;
     VisibilitySelectionOptions options_;
+    bool oriented_;
     LightVisibility visibility_;
     std::vector<float> power_weights_;            // by position in lights_, normalized
     std::unique_ptr<VoxelLightTables> spatial_;   // the base w when options_.base == "spatial"; never cleared
