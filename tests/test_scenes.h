@@ -14,6 +14,20 @@ namespace neepp::testing {
 
 using OptionMap = std::map<std::string, std::string>;
 
+// The opening of an inline test scene: a path integrator and a perspective camera with a box-filtered film.
+inline std::string scene_header_xml(int max_depth, int fov, const std::string &origin, const std::string &target,
+                                    int width, int height) {
+    return R"(<scene version="3.0.0">
+  <integrator type="path"><integer name="max_depth" value=")" + std::to_string(max_depth) + R"("/></integrator>
+  <sensor type="perspective">
+    <float name="fov" value=")" + std::to_string(fov) + R"("/>
+    <transform name="to_world"><lookat origin=")" + origin + R"(" target=")" + target + R"(" up="0,1,0"/></transform>
+    <film type="hdrfilm"><integer name="width" value=")" + std::to_string(width) + R"("/><integer name="height" value=")" +
+           std::to_string(height) + R"("/><rfilter type="box"/></film>
+  </sensor>
+)";
+}
+
 // Writes xml to a fresh file in the temp directory and returns its path.
 inline std::string write_temp_scene(const std::string &xml, const std::string &name = "scene.xml") {
     static int counter = 0;

@@ -3,19 +3,13 @@
 // visibility each favour different lights), the camera in the first room looking down the row.
 #pragma once
 #include <string>
+#include "test_scenes.h"
 
 namespace neepp::testing {
 
 inline std::string light_rooms_xml(int rooms = 4, bool environment = false, int width = 24, int height = 18) {
     const float length = 2.f * float(rooms);
-    std::string xml = R"(<scene version="3.0.0">
-  <integrator type="path"><integer name="max_depth" value="4"/></integrator>
-  <sensor type="perspective">
-    <float name="fov" value="70"/>
-    <transform name="to_world"><lookat origin="0.3,1.1,0.6" target="3,0.8,0" up="0,1,0"/></transform>
-    <film type="hdrfilm"><integer name="width" value=")" + std::to_string(width) + R"("/><integer name="height" value=")" +
-                      std::to_string(height) + R"("/><rfilter type="box"/></film>
-  </sensor>
+    std::string xml = scene_header_xml(4, 70, "0.3,1.1,0.6", "3,0.8,0", width, height) + R"(
   <bsdf type="twosided" id="white"><bsdf type="diffuse"><rgb name="reflectance" value="0.6"/></bsdf></bsdf>
   <shape type="cube"><transform name="to_world"><scale x=")" + std::to_string(length / 2) + R"(" y="1" z="1"/><translate x=")" +
                       std::to_string(length / 2) + R"(" y="1"/></transform><ref id="white"/></shape>

@@ -1,5 +1,7 @@
 """The project's own scenes (scenes/*/scene.xml: the demo and the many-light scenes) render the same
-image in neepp as in Mitsuba 3, with the default light sampler and with the NEE++ visibility-aware one.
+image in neepp as in Mitsuba 3 with every light sampler (and with NEE++'s rejection on top of the
+visibility-aware one): the unbiasedness of each sampler on the many-light scenes, against an
+independent renderer.
 
 Each scene is rendered at a quarter of its default resolution with both renderers (Mitsuba cached under
 .cache/mitsuba) and the image means are compared: the difference must stay within 4 standard errors
@@ -46,7 +48,11 @@ def mitsuba_image(xml: Path, variant: str):
     return _memo[key]
 
 
-@pytest.mark.parametrize("light_sampler", ["power", "visibility"])
+SAMPLERS = ["power", "uniform", "spatial", "spatial-oriented", "bvh", "visibility", "visibility-power",
+            "visibility-bvh", "visibility+neepp-adaptive"]
+
+
+@pytest.mark.parametrize("light_sampler", SAMPLERS)
 @pytest.mark.parametrize("scene", SCENES)
 def test_scene_matches_mitsuba(scene, light_sampler, neepp_bin, mitsuba_variant):
     xml = REPO_ROOT / "scenes" / scene / "scene.xml"
@@ -55,8 +61,10 @@ def test_scene_matches_mitsuba(scene, light_sampler, neepp_bin, mitsuba_variant)
         pytest.skip(f"{scene} needs {missing} (from ../shared/scenes), which is absent")
     w, h = _size(xml)
     ref = mitsuba_image(xml, mitsuba_variant)
+    sampler, _, policy = light_sampler.partition("+")
+    args = {"light_sampler": sampler} | ({"shadow_rays": policy} if policy else {})
     r = runner.run_neepp(xml, OUT / f"{scene}_{light_sampler}.exr", spp=SPP, resx=w, resy=h, max_depth=MAX_DEPTH,
-                         seed=11, integrator_args={"light_sampler": light_sampler}, binary=neepp_bin, timeout=600)
+                         seed=11, integrator_args=args, binary=neepp_bin, timeout=600)
     m, mr = metrics.image_mean(r.image), metrics.image_mean(ref)
     se = metrics.mean_stderr(r.image, ref)
     msg = (f"{scene} ({light_sampler}, {w}x{h}, {SPP} spp): neepp mean {m:.5g}, Mitsuba {mr:.5g}, "

@@ -1,6 +1,7 @@
 // Small scenes with hard visibility for the NEE++ tests, written inline as Mitsuba XML.
 #pragma once
 #include <string>
+#include "test_scenes.h"
 
 namespace neepp::testing {
 
@@ -8,14 +9,7 @@ namespace neepp::testing {
 // opening; the only light is on the ceiling of the far room. Most shadow rays from the camera's room are
 // blocked by the wall: the case NEE++ is for. `door_closed` fills the opening with a panel.
 inline std::string two_rooms_xml(bool door_closed = false, int width = 24, int height = 18) {
-    std::string xml = R"(<scene version="3.0.0">
-  <integrator type="path"><integer name="max_depth" value="5"/></integrator>
-  <sensor type="perspective">
-    <float name="fov" value="75"/>
-    <transform name="to_world"><lookat origin="-1.9,1.2,0.7" target="0,0.7,-0.1" up="0,1,0"/></transform>
-    <film type="hdrfilm"><integer name="width" value=")" + std::to_string(width) + R"("/><integer name="height" value=")" +
-                      std::to_string(height) + R"("/><rfilter type="box"/></film>
-  </sensor>
+    std::string xml = scene_header_xml(5, 75, "-1.9,1.2,0.7", "0,0.7,-0.1", width, height) + R"(
   <bsdf type="twosided" id="white"><bsdf type="diffuse"><rgb name="reflectance" value="0.7"/></bsdf></bsdf>
   <bsdf type="twosided" id="red"><bsdf type="diffuse"><rgb name="reflectance" value="0.7,0.2,0.2"/></bsdf></bsdf>
   <shape type="cube"><transform name="to_world"><scale x="2" y="1" z="1"/><translate y="1"/></transform><ref id="white"/></shape>
@@ -33,14 +27,7 @@ inline std::string two_rooms_xml(bool door_closed = false, int width = 24, int h
 
 // A closed room lit only by a constant environment through a window in one wall.
 inline std::string window_room_xml(int width = 24, int height = 18) {
-    return R"(<scene version="3.0.0">
-  <integrator type="path"><integer name="max_depth" value="4"/></integrator>
-  <sensor type="perspective">
-    <float name="fov" value="80"/>
-    <transform name="to_world"><lookat origin="0.8,1.0,0.8" target="-0.5,0.6,-0.6" up="0,1,0"/></transform>
-    <film type="hdrfilm"><integer name="width" value=")" + std::to_string(width) + R"("/><integer name="height" value=")" +
-           std::to_string(height) + R"("/><rfilter type="box"/></film>
-  </sensor>
+    return scene_header_xml(4, 80, "0.8,1.0,0.8", "-0.5,0.6,-0.6", width, height) + R"(
   <bsdf type="twosided" id="white"><bsdf type="diffuse"><rgb name="reflectance" value="0.6"/></bsdf></bsdf>
   <emitter type="constant"><rgb name="radiance" value="3"/></emitter>
   <shape type="rectangle"><transform name="to_world"><scale value="1"/><rotate x="1" angle="-90"/></transform><ref id="white"/></shape>

@@ -117,6 +117,18 @@ float BVHLightSampler::infinite_probability() const {
     return float(infinite_.size()) / float(infinite_.size() + (nodes_.empty() ? 0 : 1));
 }
 
+float BVHLightSampler::first_child_probability(uint32_t node, const LightSampleContext &ctx, const float *factor) const {
+    const uint32_t first = node + 1, second = nodes_[node].child_or_light;
+    float i0 = nodes_[first].bounds.importance(ctx.p, ctx.n);
+    float i1 = nodes_[second].bounds.importance(ctx.p, ctx.n);
+    if (factor) {
+        i0 *= factor[first];
+        i1 *= factor[second];
+    }
+    if (!(i0 > 0) && !(i1 > 0)) return -1.f;
+    return i0 / (i0 + i1);
+}
+
 SampledLight BVHLightSampler::sample_weighted(const LightSampleContext &ctx, float u, const float *factor) const {
     const float p_inf = infinite_probability();
     if (u < p_inf) {
@@ -130,14 +142,8 @@ SampledLight BVHLightSampler::sample_weighted(const LightSampleContext &ctx, flo
     uint32_t node = 0;
     while (!nodes_[node].leaf) {
         const uint32_t first = node + 1, second = nodes_[node].child_or_light;
-        float i0 = nodes_[first].bounds.importance(ctx.p, ctx.n);
-        float i1 = nodes_[second].bounds.importance(ctx.p, ctx.n);
-        if (factor) {
-            i0 *= factor[first];
-            i1 *= factor[second];
-        }
-        if (!(i0 > 0) && !(i1 > 0)) return {};
-        const float p0 = i0 / (i0 + i1);
+        const float p0 = first_child_probability(node, ctx, factor);
+        if (p0 < 0) return {};
         if (u < p0) {
             u = std::min(u / p0, kOneMinusEpsilon);
             pmf *= p0;
@@ -164,14 +170,8 @@ float BVHLightSampler::pmf_weighted(const LightSampleContext &ctx, const Light &
     uint32_t node = 0;
     for (int d = 0; d < trail.length; ++d) {
         const uint32_t first = node + 1, second = nodes_[node].child_or_light;
-        float i0 = nodes_[first].bounds.importance(ctx.p, ctx.n);
-        float i1 = nodes_[second].bounds.importance(ctx.p, ctx.n);
-        if (factor) {
-            i0 *= factor[first];
-            i1 *= factor[second];
-        }
-        if (!(i0 > 0) && !(i1 > 0)) return 0.f;
-        const float p0 = i0 / (i0 + i1);
+        const float p0 = first_child_probability(node, ctx, factor);
+        if (p0 < 0) return 0.f;
         if ((trail.bits >> d) & 1) {
             pmf *= 1 - p0;
             node = second;

@@ -47,6 +47,9 @@ private:
     uint32_t build(std::vector<std::pair<const Light *, LightBounds>> &items, size_t begin, size_t end,
                    uint64_t bits, int depth);
     float infinite_probability() const;
+    // Probability of descending from an interior node into its first child (-1: neither child can light
+    // ctx). sample and pmf both call it, so their products agree to the bit.
+    float first_child_probability(uint32_t node, const LightSampleContext &ctx, const float *factor) const;
 
     std::vector<const Light *> infinite_;
     std::vector<Node> nodes_;
