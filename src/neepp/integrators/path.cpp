@@ -9,11 +9,12 @@
 namespace neepp {
 
 namespace {
-// The light-selection context of a scattering vertex: its normal turned toward the side the path
-// arrived from (the side it gathers light on), so that orientation-aware samplers see which way it
-// faces. Used both where lights are sampled and where MIS asks for the pmf, so the two agree.
-LightSampleContext light_context(const SurfaceInteraction &si) {
-    return {si.p, dot(si.to_world(si.wi), si.n) < 0 ? -si.n : si.n};
+// The light-selection context of a scattering vertex reached along direction d: its normal turned
+// toward the side the path arrived from (the side it gathers light on), so that orientation-aware
+// samplers see which way it faces. Made once per vertex and used both where lights are sampled and
+// where MIS asks for the pmf, so the two agree.
+LightSampleContext light_context(const SurfaceInteraction &si, const Vec3 &d) {
+    return {si.p, dot(d, si.n) > 0 ? -si.n : si.n};
 }
 }  // namespace
 
@@ -65,9 +66,9 @@ float PathIntegrator::emission_weight(const Light &light, const LightSampleConte
     return mis_power(prev_pdf, light_pdf);
 }
 
-Color PathIntegrator::sample_direct(const Scene &scene, const SurfaceInteraction &si, const BSDF &bsdf,
-                                    const Color &beta, Sampler &sampler, RenderCounters &counters) const {
-    LightSampleContext ctx = light_context(si);
+Color PathIntegrator::sample_direct(const Scene &scene, const SurfaceInteraction &si, const LightSampleContext &ctx,
+                                    const BSDF &bsdf, const Color &beta, Sampler &sampler,
+                                    RenderCounters &counters) const {
     SampledLight sl = light_sampler_->sample(ctx, sampler.next_1d());
     Vec2 u = sampler.next_2d();
     if (!sl.light || sl.pmf <= 0) return Color(0.f);
@@ -123,8 +124,9 @@ Color PathIntegrator::Li(const Scene &scene, const Ray &primary, Sampler &sample
         if (options_.max_depth >= 0 && depth + 1 >= options_.max_depth) break;
 
         const BSDF &bsdf = *si.shape->bsdf;
+        const LightSampleContext ctx = light_context(si, ray.d);
         if (options_.nee && bsdf.has_flag(BSDFSmooth))
-            L += sample_direct(scene, si, bsdf, beta, sampler, counters);
+            L += sample_direct(scene, si, ctx, bsdf, beta, sampler, counters);
 
         float u1 = sampler.next_1d();
         Vec2 u2 = sampler.next_2d();
@@ -132,7 +134,7 @@ Color PathIntegrator::Li(const Scene &scene, const Ray &primary, Sampler &sample
         if (!bs.valid()) break;
         beta *= bs.weight;
         eta *= bs.eta;
-        prev = light_context(si);
+        prev = ctx;
         prev_bsdf_pdf = bs.pdf;
         prev_delta = (bs.sampled_flags & BSDFDelta) != 0;
         ray = si.spawn_ray(si.to_world(bs.wo));

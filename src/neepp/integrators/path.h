@@ -35,8 +35,8 @@ private:
     // Radiance from light sources by light sampling at si, MIS-weighted against BSDF sampling and
     // multiplied by the path throughput beta (so contribution-aware shadow-ray policies see the sample's
     // full contribution).
-    Color sample_direct(const Scene &scene, const SurfaceInteraction &si, const class BSDF &bsdf, const Color &beta,
-                        Sampler &sampler, RenderCounters &counters) const;
+    Color sample_direct(const Scene &scene, const SurfaceInteraction &si, const LightSampleContext &ctx,
+                        const class BSDF &bsdf, const Color &beta, Sampler &sampler, RenderCounters &counters) const;
     // MIS weight for emission found by a BSDF-sampled ray leaving prev (pdf prev_pdf) toward light.
     float emission_weight(const Light &light, const LightSampleContext &prev, const DirectionSample &ds,
                           float prev_pdf) const;

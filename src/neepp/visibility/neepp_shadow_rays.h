@@ -117,7 +117,9 @@ private:
     double load_time_s_ = 0;
     double adaptive_scale_ = 0;
     Totals totals_;
-    mutable tbb::enumerable_thread_specific<ThreadState> threads_;
+    // Native thread-local keys: local() is read on every shadow query, where the default hash lookup showed.
+    mutable tbb::enumerable_thread_specific<ThreadState, tbb::cache_aligned_allocator<ThreadState>, tbb::ets_key_per_instance>
+        threads_;
 };
 
 }  // namespace neepp

@@ -37,20 +37,6 @@ VoxelGrid VoxelGrid::with_exact_bounds(const BBox &bounds, int resolution) {
     return g;
 }
 
-uint32_t VoxelGrid::voxel_of(const Vec3 &p) const {
-    auto axis = [&](float v, float lo, float inv) {
-        float f = (v - lo) * inv;
-        // Written so NaN lands on 0: !(f >= 0) is true for NaN.
-        if (!(f >= 0.f)) return 0;
-        int i = f >= float(n_) ? n_ - 1 : int(f);
-        return std::min(i, n_ - 1);
-    };
-    int x = axis(p.x, bounds_.lo.x, inv_cell_size_.x);
-    int y = axis(p.y, bounds_.lo.y, inv_cell_size_.y);
-    int z = axis(p.z, bounds_.lo.z, inv_cell_size_.z);
-    return uint32_t(x + n_ * (y + n_ * z));
-}
-
 void VoxelGrid::voxel_coords(uint32_t cell, int &x, int &y, int &z) const {
     x = int(cell % uint32_t(n_));
     y = int((cell / uint32_t(n_)) % uint32_t(n_));

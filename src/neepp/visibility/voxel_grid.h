@@ -3,6 +3,7 @@
 // lights (a shadow ray to the sky has no end point, only a direction). A cell is an index in
 // [0, cell_count()): voxels first (linear x + N·(y + N·z)), then the direction bins.
 #pragma once
+#include <algorithm>
 #include <cstdint>
 #include "neepp/math/bbox.h"
 #include "neepp/math/vec.h"
@@ -32,7 +33,13 @@ public:
     bool is_direction_cell(uint32_t cell) const { return cell >= voxel_count(); }
 
     // The voxel holding p; points outside the grid are clamped to the nearest boundary voxel (NaNs map to 0).
-    uint32_t voxel_of(const Vec3 &p) const;
+    // Inline: every NEE++ shadow query and visibility-aware light choice asks it.
+    uint32_t voxel_of(const Vec3 &p) const {
+        int x = axis_index(p.x, bounds_.lo.x, inv_cell_size_.x);
+        int y = axis_index(p.y, bounds_.lo.y, inv_cell_size_.y);
+        int z = axis_index(p.z, bounds_.lo.z, inv_cell_size_.z);
+        return uint32_t(x + n_ * (y + n_ * z));
+    }
     // The direction-bin cell of a (not necessarily unit) direction.
     uint32_t cell_of_direction(const Vec3 &d) const;
     // Integer coordinates of a voxel cell.
@@ -42,6 +49,12 @@ public:
     Vec3 direction_in_bin(uint32_t cell, Vec2 u) const;
 
 private:
+    int axis_index(float v, float lo, float inv) const {
+        const float f = (v - lo) * inv;
+        if (!(f >= 0.f)) return 0;  // written so that NaN lands on 0: !(f >= 0) is true for NaN
+        return f >= float(n_) ? n_ - 1 : std::min(int(f), n_ - 1);
+    }
+
     int n_ = 0;
     BBox bounds_;
     Vec3 inv_cell_size_;
