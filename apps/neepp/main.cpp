@@ -8,6 +8,7 @@
 #include <CLI/CLI.hpp>
 #include <fmt/core.h>
 #include "neepp/integrators/integrator.h"
+#include "neepp/light_selection/factory.h"
 #include "neepp/loader/scene_loader.h"
 #include "neepp/render/render_output.h"
 
@@ -158,7 +159,12 @@ int main(int argc, char **argv) {
     render->add_option("--threads", ra.threads, "Worker threads (default: all cores)")->check(CLI::Range(1, 1024));
     render->add_option("-D", ra.defines, "Scene parameter override name=value (as mitsuba -D)");
     render->add_option("--integrator", ra.integrator, "Integrator (default: the scene's)");
-    render->add_option("-I", ra.integrator_options, "Integrator option key=value");
+    std::string samplers;
+    for (const std::string &n : neepp::light_sampler_names()) samplers += (samplers.empty() ? "" : ", ") + n;
+    render->add_option("-I", ra.integrator_options,
+                       "Integrator option key=value; path: max_depth, rr_depth, hide_emitters, nee, light_sampler (" +
+                           samplers + "), shadow_rays (nee, neepp, neepp-adaptive, neepp-cv), voxels, samples_per_pair, "
+                           "q_min, learn, adaptive_target, shadow_ray_cost (see README)");
     render->add_option("--sampler", ra.sampler, "Sampler: independent or sobol (default: the scene's)");
     render->add_option("--rfilter", ra.rfilter, "Override the film's reconstruction filter")
         ->check(CLI::IsMember({"box", "tent", "gaussian"}));
