@@ -103,44 +103,76 @@ neepp::Image side_by_side(const neepp::Image &left, const neepp::Image &right) {
     return out;
 }
 
-// The demo: the built-in door-ajar scene with plain NEE, then with NEE++ for the same wall time, so a
-// first-time user sees what NEE++ buys (more samples per pixel, less noise, in equal time).
-void run_demo(const std::string &dir, int spp, bool quiet) {
-    std::filesystem::create_directories(dir);
-    RenderArgs nee;
-    nee.scene = std::string(NEEPP_SCENES_DIR) + "/door-ajar/scene.xml";
-    nee.output = dir + "/demo_nee.exr";
-    nee.stats = dir + "/demo_nee.json";
-    nee.spp = spp;
-    nee.quiet = quiet;
-    nee.integrator_options = {"shadow_rays=nee"};
-    Rendered a = run_render(nee);
+// One comparison of the demo: scene rendered with the baseline options at spp, then with the NEE++
+// options for the same wall time; writes demo_<base>/<alt> images and statistics, a side-by-side PNG,
+// and returns the pair's summary.
+nlohmann::json demo_pair(const std::string &dir, const std::string &scene, int spp, bool quiet, const std::string &base,
+                         const std::vector<std::string> &base_options, const std::string &alt,
+                         const std::vector<std::string> &alt_options, const std::string &side_by_side_name) {
+    RenderArgs a_args;
+    a_args.scene = std::string(NEEPP_SCENES_DIR) + "/" + scene + "/scene.xml";
+    a_args.output = dir + "/demo_" + base + ".exr";
+    a_args.stats = dir + "/demo_" + base + ".json";
+    a_args.spp = spp;
+    a_args.quiet = quiet;
+    a_args.integrator_options = base_options;
+    Rendered a = run_render(a_args);
 
-    RenderArgs pp = nee;
-    pp.output = dir + "/demo_neepp.exr";
-    pp.stats = dir + "/demo_neepp.json";
-    pp.spp = 0;
-    pp.time_s = a.stats["render_time_s"].get<double>();
-    pp.integrator_options = {"shadow_rays=neepp-adaptive"};  // the best policy measured (see the closing notes)
-    Rendered b = run_render(pp);
+    RenderArgs b_args = a_args;
+    b_args.output = dir + "/demo_" + alt + ".exr";
+    b_args.stats = dir + "/demo_" + alt + ".json";
+    b_args.spp = 0;
+    b_args.time_s = a.stats["render_time_s"].get<double>();
+    b_args.integrator_options = alt_options;
+    Rendered b = run_render(b_args);
 
-    neepp::write_png_srgb(dir + "/demo_side_by_side.png", side_by_side(a.image, b.image));
+    neepp::write_png_srgb(dir + "/" + side_by_side_name, side_by_side(a.image, b.image));
     auto ratio = [&](const char *k) {
         double d = a.stats[k].get<double>();
         return d > 0 ? b.stats[k].get<double>() / d : 0.0;
     };
-    nlohmann::json summary = {{"equal_time_s", pp.time_s},
-                              {"nee", a.stats},
-                              {"neepp", b.stats},
-                              {"spp_ratio_neepp_over_nee", ratio("spp")},
-                              {"shadow_rays_per_sample_ratio", ratio("shadow_rays") / std::max(1e-12, ratio("spp"))}};
+    return {{"scene", scene},
+            {"equal_time_s", b_args.time_s},
+            {base, a.stats},
+            {alt, b.stats},
+            {"spp_ratio", ratio("spp")},
+            {"shadow_rays_per_sample_ratio", ratio("shadow_rays") / std::max(1e-12, ratio("spp"))},
+            {"occluded_fraction", {{base, a.stats["shadow_rays_occluded"].get<double>() /
+                                              std::max(1.0, a.stats["shadow_rays"].get<double>())},
+                                   {alt, b.stats["shadow_rays_occluded"].get<double>() /
+                                             std::max(1.0, b.stats["shadow_rays"].get<double>())}}},
+            {"side_by_side", side_by_side_name}};
+}
+
+// The demo, two equal-time comparisons a first-time user can look at:
+//  1. shadow-ray rejection: the built-in door-ajar scene (a room lit through a door ajar) with plain NEE,
+//     then with NEE++'s best policy: more samples per pixel in the same time;
+//  2. light selection: the office scene (30 lights, most behind walls) with power-proportional light
+//     choice, then with NEE++'s visibility-aware choice: shadow rays spent on lights that are seen.
+void run_demo(const std::string &dir, int spp, bool quiet) {
+    std::filesystem::create_directories(dir);
+    nlohmann::json rejection = demo_pair(dir, "door-ajar", spp, quiet, "nee", {"shadow_rays=nee"}, "neepp",
+                                         {"shadow_rays=neepp-adaptive"},  // the best policy measured
+                                         "demo_side_by_side.png");
+    nlohmann::json selection = demo_pair(dir, "office", spp, quiet, "lights_power", {"light_sampler=power"},
+                                         "lights_visibility", {"light_sampler=visibility"},
+                                         "demo_lights_side_by_side.png");
+    nlohmann::json summary = {{"shadow_ray_rejection", rejection}, {"light_selection", selection}};
     std::ofstream(dir + "/demo_summary.json") << summary.dump(2) << "\n";
-    if (!quiet)
+    if (!quiet) {
         fmt::print(stderr,
                    "neepp demo: in {:.2f} s, NEE reached {} spp and NEE++ {} spp ({:.2f}x), with {:.2f}x the shadow rays per "
                    "sample; see {}/demo_side_by_side.png (left NEE, right NEE++)\n",
-                   pp.time_s, a.stats["spp"].get<int>(), b.stats["spp"].get<int>(), ratio("spp"),
-                   summary["shadow_rays_per_sample_ratio"].get<double>(), dir);
+                   rejection["equal_time_s"].get<double>(), rejection["nee"]["spp"].get<int>(),
+                   rejection["neepp"]["spp"].get<int>(), rejection["spp_ratio"].get<double>(),
+                   rejection["shadow_rays_per_sample_ratio"].get<double>(), dir);
+        fmt::print(stderr,
+                   "neepp demo: office, 30 lights, {:.2f} s each: {:.0f} % of power sampling's shadow rays were occluded, "
+                   "{:.0f} % of visibility-aware selection's; see {}/demo_lights_side_by_side.png (left power, right "
+                   "visibility)\n",
+                   selection["equal_time_s"].get<double>(), 100 * selection["occluded_fraction"]["lights_power"].get<double>(),
+                   100 * selection["occluded_fraction"]["lights_visibility"].get<double>(), dir);
+    }
 }
 
 }  // namespace
@@ -177,7 +209,7 @@ int main(int argc, char **argv) {
     int demo_spp = 64;
     bool demo_quiet = false;
     auto *demo = app.add_subcommand("demo", "Render the built-in demo scene (a room lit through a door ajar) with NEE "
-                                            "and with NEE++ at equal time");
+                                            "and with NEE++ at equal time, and the office scene with power and visibility-aware light selection");
     demo->add_option("-o,--output-dir", demo_dir, "Directory for the demo's images and statistics");
     demo->add_option("--spp", demo_spp, "Samples per pixel")->check(CLI::Range(1, 1 << 20));
     demo->add_flag("-q,--quiet", demo_quiet, "No progress bar or messages");

@@ -108,4 +108,12 @@ def test_bad_options_give_a_clear_error(neepp_bin, tmp_path, args, expect):
 def test_demo_writes_its_outputs(neepp_bin, tmp_path):
     r = run(neepp_bin, "demo", "-o", tmp_path / "demo", "--spp", 1, "--quiet", timeout=300)
     assert r.returncode == 0, r.stderr
-    assert any(p.suffix == ".png" for p in (tmp_path / "demo").iterdir())
+    d = tmp_path / "demo"
+    for name in ("nee", "neepp", "lights_power", "lights_visibility"):
+        for ext in ("exr", "png", "json"):
+            assert (d / f"demo_{name}.{ext}").is_file(), f"demo_{name}.{ext} missing"
+    for name in ("demo_side_by_side.png", "demo_lights_side_by_side.png", "demo_summary.json"):
+        assert (d / name).is_file(), f"{name} missing"
+    summary = json.loads((d / "demo_summary.json").read_text())
+    assert set(summary) == {"shadow_ray_rejection", "light_selection"}
+    assert summary["light_selection"]["lights_visibility"]["integrator"]["light_sampler"] == "visibility"
