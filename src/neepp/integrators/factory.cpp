@@ -1,5 +1,4 @@
 #include <stdexcept>
-#include <algorithm>
 #include "neepp/integrators/path.h"
 #include "neepp/light_selection/factory.h"
 #include "neepp/visibility/neepp_shadow_rays.h"
@@ -15,9 +14,7 @@ std::unique_ptr<Integrator> make_integrator(const std::string &name, const Optio
         o.hide_emitters = options.get_bool("hide_emitters", o.hide_emitters);
         o.nee = options.get_bool("nee", o.nee);
         o.light_sampler = options.get_string("light_sampler", o.light_sampler);
-        const auto &names = light_sampler_names();
-        if (std::find(names.begin(), names.end(), o.light_sampler) == names.end())
-            make_light_sampler(o.light_sampler, {});  // throws, listing the names
+        check_light_sampler_name(o.light_sampler);
         if (o.max_depth < -1 || o.max_depth == 0) throw std::invalid_argument("max_depth must be -1 or >= 1");
         if (o.rr_depth < 1) throw std::invalid_argument("rr_depth must be >= 1");
         // Shadow-ray policy: nee traces every shadow ray; the neepp* policies (NEE++) play Russian roulette

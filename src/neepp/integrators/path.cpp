@@ -22,14 +22,14 @@ PathIntegrator::PathIntegrator(PathOptions options, std::unique_ptr<ShadowRayTes
     : options_(std::move(options)), shadow_(std::move(shadow)) {}
 
 void PathIntegrator::prepare(const Scene &scene) {
-    // With a single light every sampler's pmf is 1: use the cheapest, and do not build a visibility map
-    // that only light selection would have read (the map is still built when a policy rejects with it).
-    const bool one_light = scene.lights().size() <= 1;
-    if (one_light && light_sampler_needs_visibility_map(options_.light_sampler) && shadow_->policy() == "nee")
+    // The factory keeps a map for a sampler that may read one; on a scene where it does not (one light),
+    // a map that no shadow-ray policy uses either is not built.
+    if (shadow_->policy() == "nee" && shadow_->visibility_map() &&
+        !light_sampler_needs_visibility_map(options_.light_sampler, scene.lights().size()))
         shadow_ = std::make_unique<TraceAllShadowRays>();
     shadow_->prepare(scene);  // NEE++: build or load the visibility map
     LightSelectionInputs inputs{&scene, shadow_->voxel_grid(), shadow_->visibility_map(), options_.voxels};
-    light_sampler_ = make_light_sampler(one_light ? "power" : options_.light_sampler, scene.light_pointers(), inputs);
+    light_sampler_ = make_light_sampler(options_.light_sampler, scene.light_pointers(), inputs);
 }
 
 void PathIntegrator::end_pass(const Scene &, const PassStatistics &pass) {

@@ -30,16 +30,14 @@ float surface_area(const BBox &b) {
 BVHLightSampler::BVHLightSampler(std::vector<const Light *> lights) {
     uint32_t max_index = 0;
     for (const Light *l : lights) max_index = std::max(max_index, l->index);
-    trails_.assign(lights.empty() ? 0 : max_index + 1, Trail{});
-    is_infinite_.assign(trails_.size(), 0);
-    light_by_index_.assign(trails_.size(), nullptr);
-    for (const Light *l : lights) light_by_index_[l->index] = l;
+    entries_.assign(lights.empty() ? 0 : max_index + 1, Entry{});
+    for (const Light *l : lights) entries_[l->index].light = l;
     std::vector<std::pair<const Light *, LightBounds>> items;
     for (const Light *l : lights) {
         std::optional<LightBounds> b = l->is_infinite() ? std::nullopt : l->bounds();
         if (!b) {  // infinite (or unbounded) lights are chosen apart
             infinite_.push_back(l);
-            is_infinite_[l->index] = 1;
+            entries_[l->index].infinite = true;
         } else if (b->phi > 0) {  // a light without power can light nothing: leave it out
             items.emplace_back(l, *b);
         }
@@ -53,7 +51,9 @@ uint32_t BVHLightSampler::build(std::vector<std::pair<const Light *, LightBounds
     const uint32_t index = uint32_t(nodes_.size());
     if (end - begin == 1) {
         nodes_.push_back({CompactLightBounds(items[begin].second), items[begin].first->index, true});
-        trails_[items[begin].first->index] = {bits, depth};
+        Entry &e = entries_[items[begin].first->index];
+        e.bits = bits;
+        e.length = depth;
         return index;
     }
     LightBounds all;
@@ -157,14 +157,14 @@ SampledLight BVHLightSampler::sample_weighted(const LightSampleContext &ctx, flo
     // A leaf reached through a sibling's importance may itself light nothing here.
     if (!(nodes_[node].bounds.importance(ctx.p, ctx.n) > 0)) return {};
     const uint32_t light = nodes_[node].child_or_light;
-    return {light_by_index_[light], pmf};
+    return {entries_[light].light, pmf};
 }
 
 float BVHLightSampler::pmf_weighted(const LightSampleContext &ctx, const Light &light, const float *factor) const {
-    if (light.index >= trails_.size()) return 0.f;
+    if (light.index >= entries_.size()) return 0.f;
     const float p_inf = infinite_probability();
-    if (is_infinite_[light.index]) return p_inf / float(infinite_.size());
-    const Trail trail = trails_[light.index];
+    const Entry &trail = entries_[light.index];
+    if (trail.infinite) return p_inf / float(infinite_.size());
     if (trail.length < 0) return 0.f;
     float pmf = 1 - p_inf;
     uint32_t node = 0;

@@ -30,7 +30,7 @@ public:
     size_t node_count() const { return nodes_.size(); }
     bool is_leaf(uint32_t node) const { return nodes_[node].leaf; }
     uint32_t second_child(uint32_t node) const { return nodes_[node].child_or_light; }
-    const Light &leaf_light(uint32_t node) const { return *light_by_index_[nodes_[node].child_or_light]; }
+    const Light &leaf_light(uint32_t node) const { return *entries_[nodes_[node].child_or_light].light; }
     float node_power(uint32_t node) const { return nodes_[node].bounds.phi; }
     int depth() const { return depth_; }
 
@@ -40,9 +40,12 @@ private:
         uint32_t child_or_light = 0;  // interior: second child (the first is the next node); leaf: light
         bool leaf = false;
     };
-    struct Trail {
-        uint64_t bits = 0;  // bit d: went to the second child at depth d
-        int length = -1;    // -1: not in the BVH
+    // What the sampler knows of each light, by Light::index.
+    struct Entry {
+        const Light *light = nullptr;
+        bool infinite = false;  // chosen apart from the tree
+        uint64_t bits = 0;      // path from the root: bit d set = went to the second child at depth d
+        int length = -1;        // path length; -1: not in the tree (infinite, or without power)
     };
     uint32_t build(std::vector<std::pair<const Light *, LightBounds>> &items, size_t begin, size_t end,
                    uint64_t bits, int depth);
@@ -53,9 +56,7 @@ private:
 
     std::vector<const Light *> infinite_;
     std::vector<Node> nodes_;
-    std::vector<Trail> trails_;  // by Light::index
-    std::vector<const Light *> light_by_index_;
-    std::vector<uint8_t> is_infinite_;  // by Light::index
+    std::vector<Entry> entries_;  // by Light::index
     int depth_ = 0;
 };
 

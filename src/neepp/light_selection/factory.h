@@ -19,11 +19,15 @@ struct LightSelectionInputs {
     int voxels = 16;                     // resolution of the spatial sampler's own grid, without a map
 };
 
-// The names make_light_sampler accepts.
+// The names make_light_sampler accepts; check_light_sampler_name throws std::invalid_argument, listing
+// them, for any other.
 const std::vector<std::string> &light_sampler_names();
-// Samplers that read the visibility map: the integrator must then keep one (NEE++'s shadow-ray component).
-bool light_sampler_needs_visibility_map(const std::string &name);
-// Throws std::invalid_argument for unknown names or missing inputs.
+void check_light_sampler_name(const std::string &name);
+// Whether sampler `name` over light_count lights reads the visibility map, so the integrator must keep
+// one (NEE++'s shadow-ray component). Without a count: whether it may, for some scene.
+bool light_sampler_needs_visibility_map(const std::string &name, size_t light_count = 2);
+// Throws std::invalid_argument for unknown names or missing inputs. With a single light every sampler's
+// pmf is 1, so every name gives the cheapest, power (whose statistics then say so).
 std::unique_ptr<LightSampler> make_light_sampler(const std::string &name, std::vector<const Light *> lights,
                                                  const LightSelectionInputs &inputs = {});
 

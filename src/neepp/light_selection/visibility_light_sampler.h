@@ -30,27 +30,21 @@ public:
     // learning into the map between passes).
     VisibilityLightSampler(std::vector<const Light *> lights, const VoxelGrid &grid, const VisibilityMap &map,
                            const Vec3 &reference, VisibilitySelectionOptions options = {});
-    SampledLight sample(const LightSampleContext &ctx, float u) const override { return tables_.sample(key(ctx), u); }
-    float pmf(const LightSampleContext &ctx, const Light &light) const override { return tables_.pmf(key(ctx), light); }
+    SampledLight sample(const LightSampleContext &ctx, float u) const override { return tables_.sample(keys_.of(ctx), u); }
+    float pmf(const LightSampleContext &ctx, const Light &light) const override { return tables_.pmf(keys_.of(ctx), light); }
     std::string name() const override { return "visibility"; }
     void end_pass() override;
     nlohmann::json statistics() const override;
 
 private:
-    // The table a shading point reads: its voxel, and its orientation bucket when tables are oriented.
-    uint32_t key(const LightSampleContext &ctx) const {
-        const uint32_t v = grid_.voxel_of(ctx.p);
-        return oriented_ ? v * kNormalBuckets + normal_bucket(ctx.n) : v;
-    }
     void weights(uint32_t key, std::vector<float> &w) const;
 
     std::vector<const Light *> lights_;
-    const VoxelGrid &grid_;
     VisibilitySelectionOptions options_;
-    bool oriented_;
     LightVisibility visibility_;
-    std::vector<float> power_weights_;            // by position in lights_, normalized
-    std::unique_ptr<VoxelLightTables> spatial_;   // the base w when options_.base == "spatial"; never cleared
+    std::vector<float> power_;                       // power_fractions, the base w when options_.base == "power"
+    std::unique_ptr<SpatialLightSampler> spatial_;   // the base w when options_.base == "spatial"; never rebuilt
+    TableKeys keys_;                                 // the base's keys (per voxel for power)
     VoxelLightTables tables_;
     uint64_t passes_ = 0;
 };

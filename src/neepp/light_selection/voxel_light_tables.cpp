@@ -6,11 +6,9 @@
 namespace neepp {
 
 VoxelLightTables::VoxelLightTables(std::vector<const Light *> lights, uint32_t voxel_count, WeightFunction weights)
-    : lights_(std::move(lights)), weights_(std::move(weights)), tables_(voxel_count) {
-    for (const Light *l : lights_) max_index_ = std::max(max_index_, l->index);
-}
+    : lights_(std::move(lights)), weights_(std::move(weights)), tables_(voxel_count) {}
 
-std::unique_ptr<VoxelLightTables::Table> VoxelLightTables::build(uint32_t voxel) const {
+std::unique_ptr<LightDistribution> VoxelLightTables::build(uint32_t voxel) const {
     std::vector<float> w(lights_.size(), 0.f);
     weights_(voxel, w);
     double total = 0;
@@ -19,28 +17,19 @@ std::unique_ptr<VoxelLightTables::Table> VoxelLightTables::build(uint32_t voxel)
         total += x;
     }
     if (!(total > 0)) throw std::logic_error("light table without a positive weight");
-    auto t = std::make_unique<Table>();
-    t->distribution = Distribution1D(w);
-    t->pmf_by_index.assign(lights_.empty() ? 0 : max_index_ + 1, 0.f);
-    for (size_t i = 0; i < lights_.size(); ++i) t->pmf_by_index[lights_[i]->index] = t->distribution.pmf(uint32_t(i));
-    return t;
+    return std::make_unique<LightDistribution>(lights_, w);
 }
 
-const VoxelLightTables::Table &VoxelLightTables::table(uint32_t voxel) const {
+const LightDistribution &VoxelLightTables::table(uint32_t voxel) const {
     return tables_.get(voxel, [this](uint32_t v) { return build(v); });
 }
 
 SampledLight VoxelLightTables::sample(uint32_t voxel, float u) const {
-    if (lights_.empty()) return {};
-    const Table &t = table(voxel);
-    uint32_t i = t.distribution.sample_discrete(u);
-    return {lights_[i], t.pmf_by_index[lights_[i]->index]};
+    return lights_.empty() ? SampledLight{} : table(voxel).sample(lights_, u);
 }
 
 float VoxelLightTables::pmf(uint32_t voxel, const Light &light) const {
-    if (lights_.empty()) return 0.f;
-    const Table &t = table(voxel);
-    return light.index < t.pmf_by_index.size() ? t.pmf_by_index[light.index] : 0.f;
+    return lights_.empty() ? 0.f : table(voxel).pmf(light);
 }
 
 }  // namespace neepp

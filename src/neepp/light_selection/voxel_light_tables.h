@@ -21,7 +21,7 @@ public:
     SampledLight sample(uint32_t voxel, float u) const;
     float pmf(uint32_t voxel, const Light &light) const;
     // The whole pmf of a voxel, indexed by Light::index (for tests and tools).
-    const std::vector<float> &pmf_table(uint32_t voxel) const { return table(voxel).pmf_by_index; }
+    const std::vector<float> &pmf_table(uint32_t voxel) const { return table(voxel).pmf_by_index(); }
 
     // Drops every table (between passes), so they are rebuilt from the current state.
     void clear() { tables_.clear(); }
@@ -29,17 +29,12 @@ public:
     const std::vector<const Light *> &lights() const { return lights_; }
 
 private:
-    struct Table {
-        Distribution1D distribution;      // over lights_ order
-        std::vector<float> pmf_by_index;  // by Light::index, the value both sample() and pmf() report
-    };
-    const Table &table(uint32_t voxel) const;
-    std::unique_ptr<Table> build(uint32_t voxel) const;
+    const LightDistribution &table(uint32_t voxel) const;
+    std::unique_ptr<LightDistribution> build(uint32_t voxel) const;
 
     std::vector<const Light *> lights_;
-    uint32_t max_index_ = 0;
     WeightFunction weights_;
-    LazyVoxelArray<Table> tables_;
+    LazyVoxelArray<LightDistribution> tables_;
 };
 
 }  // namespace neepp

@@ -35,6 +35,29 @@ public:
     virtual nlohmann::json statistics() const { return nlohmann::json::object(); }
 };
 
+// Each light's share of the total emitted power (luminance of Light::power()), in `lights` order; uniform
+// when no light has power (e.g. black textures), so every light stays selectable.
+std::vector<float> power_fractions(const std::vector<const Light *> &lights);
+
+// A fixed discrete distribution over a list of lights whose pmf is read back by Light::index (what a
+// sampler's pmf(ctx, light) receives): sampling reports exactly the float pmf() returns.
+class LightDistribution {
+public:
+    LightDistribution() = default;
+    // weights: one per light of `lights`, non-negative, at least one positive.
+    LightDistribution(const std::vector<const Light *> &lights, const std::vector<float> &weights);
+    // A light of `lights` (the list given to the constructor) with its pmf.
+    SampledLight sample(const std::vector<const Light *> &lights, float u) const;
+    float pmf(const Light &light) const {
+        return light.index < pmf_by_index_.size() ? pmf_by_index_[light.index] : 0.f;
+    }
+    const std::vector<float> &pmf_by_index() const { return pmf_by_index_; }
+
+private:
+    Distribution1D distribution_;      // over the list's order
+    std::vector<float> pmf_by_index_;  // by Light::index
+};
+
 class UniformLightSampler final : public LightSampler {
 public:
     explicit UniformLightSampler(std::vector<const Light *> lights) : lights_(std::move(lights)) {}
@@ -52,14 +75,13 @@ private:
 class PowerLightSampler final : public LightSampler {
 public:
     explicit PowerLightSampler(std::vector<const Light *> lights);
-    SampledLight sample(const LightSampleContext &, float u) const override;
-    float pmf(const LightSampleContext &, const Light &light) const override;
+    SampledLight sample(const LightSampleContext &, float u) const override { return distribution_.sample(lights_, u); }
+    float pmf(const LightSampleContext &, const Light &light) const override { return distribution_.pmf(light); }
     std::string name() const override { return "power"; }
 
 private:
     std::vector<const Light *> lights_;
-    Distribution1D distribution_;
-    std::vector<float> pmf_by_index_;  // indexed by Light::index
+    LightDistribution distribution_;
 };
 
 }  // namespace neepp

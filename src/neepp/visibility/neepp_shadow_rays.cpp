@@ -58,7 +58,6 @@ float NeeppShadowRays::visibility(const Scene &scene, const ShadowQuery &q, Samp
     const uint32_t a = grid_.voxel_of(q.from);
     const uint32_t b = to_infinity ? grid_.cell_of_direction(q.ray.d) : grid_.voxel_of(q.to);
     const uint64_t pair = VisibilityMap::pair_index(a, b);
-    const PairCounts c = map_.counts_at(pair);
     ThreadState &ts = threads_.local();
 
     auto trace = [&] {
@@ -66,7 +65,8 @@ float NeeppShadowRays::visibility(const Scene &scene, const ShadowQuery &q, Samp
         if (options_.learn) ts.updates.record(pair, visible);
         return visible;
     };
-    if (options_.policy == ShadowRayPolicy::TraceAll) return trace() ? 1.f : 0.f;
+    if (options_.policy == ShadowRayPolicy::TraceAll) return trace() ? 1.f : 0.f;  // learns, never reads the map
+    const PairCounts c = map_.counts_at(pair);
     if (a == b || c.traced == 0) {
         ++(a == b ? ts.forced_same_cell : ts.forced_unknown);
         return trace() ? 1.f : 0.f;
