@@ -1,14 +1,35 @@
 #include "neepp/lights/environment_light.h"
 
+#include <cmath>
 #include <stdexcept>
+#include <Imath/half.h>
 #include "neepp/math/warp.h"
 
 namespace neepp {
 
 EnvironmentMapLight::EnvironmentMapLight(Image image, const Transform &to_world, float scale)
-    : image_(std::move(image)), to_world_(to_world), scale_(scale) {
-    if (image_.width < 2 || image_.height < 2) throw std::runtime_error("envmap: image too small");
-    int w = image_.width, h = image_.height;
+    : to_world_(to_world), scale_(scale) {
+    width_ = image.width, height_ = image.height;
+    if (image.width < 2 || image.height < 2) throw std::runtime_error("envmap: image too small");
+    const int w = width_, h = height_;
+    const size_t n = size_t(w) * h;
+    float largest = 0;
+    for (size_t i = 0; i < n; ++i)
+        for (int c = 0; c < 3; ++c) largest = std::max(largest, std::abs(image.rgb(int(i % w), int(i / w))[c]));
+    if (std::isfinite(largest) && largest <= float(HALF_MAX)) {
+        half_.resize(3 * n);
+        for (size_t i = 0; i < n; ++i) {
+            Color c = image.rgb(int(i % w), int(i / w));
+            for (int k = 0; k < 3; ++k) half_[3 * i + k] = imath_float_to_half(c[k]);
+        }
+    } else {
+        float_.resize(3 * n);
+        for (size_t i = 0; i < n; ++i) {
+            Color c = image.rgb(int(i % w), int(i / w));
+            for (int k = 0; k < 3; ++k) float_[3 * i + k] = c[k];
+        }
+    }
+    image = Image();  // the texels above are all that is kept
     // Sampling density ∝ luminance × sin(theta) of the row (the equirectangular area element), so the
     // directional pdf stays bounded near the poles. Each cell's weight uses the bilinear lookups' maximum
     // neighbourhood by averaging the cell corners, so no cell with radiance gets zero probability.
@@ -51,7 +72,7 @@ EnvironmentMapLight::EnvironmentMapLight(Image image, const Transform &to_world,
     double norm_w = 0;
     for (int y = 0; y < h; ++y) {
         float sin_theta = std::sin(kPi * (float(y) + 0.5f) / float(h));
-        for (int x = 0; x < w; ++x) acc += image_.rgb(x, y) * sin_theta;
+        for (int x = 0; x < w; ++x) acc += texel(x, y) * sin_theta;
         norm_w += double(sin_theta) * w;
     }
     mean_radiance_ = acc * float(scale_ / norm_w);
@@ -75,15 +96,22 @@ Vec3 EnvironmentMapLight::uv_to_direction(Vec2 uv) const {
 
 // Bilinear lookup with Mitsuba's envmap convention: texel (i, j) sits at u = i / W (the map wraps
 // horizontally) and v = j / (H - 1) (the first and last rows lie on the poles).
+Color EnvironmentMapLight::texel(int x, int y) const {
+    const size_t i = 3 * (size_t(y) * width_ + x);
+    if (!half_.empty()) return Color(imath_half_to_float(half_[i]), imath_half_to_float(half_[i + 1]),
+                                     imath_half_to_float(half_[i + 2]));
+    return Color(float_[i], float_[i + 1], float_[i + 2]);
+}
+
 Color EnvironmentMapLight::lookup(Vec2 uv) const {
-    int w = image_.width, h = image_.height;
+    const int w = width_, h = height_;
     float x = uv.x * float(w), y = uv.y * float(h - 1);
     int x0 = int(std::floor(x)), y0 = std::clamp(int(std::floor(y)), 0, h - 1);
     float fx = x - float(x0), fy = std::clamp(y - float(y0), 0.f, 1.f);
     x0 = ((x0 % w) + w) % w;
     int x1 = (x0 + 1) % w, y1 = std::min(y0 + 1, h - 1);
-    Color c = image_.rgb(x0, y0) * ((1 - fx) * (1 - fy)) + image_.rgb(x1, y0) * (fx * (1 - fy)) +
-              image_.rgb(x0, y1) * ((1 - fx) * fy) + image_.rgb(x1, y1) * (fx * fy);
+    Color c = texel(x0, y0) * ((1 - fx) * (1 - fy)) + texel(x1, y0) * (fx * (1 - fy)) +
+              texel(x0, y1) * ((1 - fx) * fy) + texel(x1, y1) * (fx * fy);
     return c;
 }
 
