@@ -3,6 +3,7 @@
 // (NEE++ publishes its visibility map there).
 #pragma once
 #include <memory>
+#include <span>
 #include <string>
 #include <nlohmann/json.hpp>
 #include "neepp/integrators/options.h"
@@ -21,6 +22,13 @@ public:
     // Called once before rendering starts (build tables, seed maps).
     virtual void prepare(const Scene &scene) {}
     virtual Color Li(const Scene &scene, const Ray &ray, Sampler &sampler, RenderCounters &counters) const = 0;
+    // The same for a batch of camera rays, each with its own sampler (set up for its pixel and sample),
+    // results in out. The default calls Li for each; an integrator that gains from having many paths in
+    // flight (to hide memory latency) overrides it, and must give exactly what Li gives.
+    virtual void Li_batch(const Scene &scene, std::span<const Ray> rays, std::span<Sampler *const> samplers,
+                          std::span<Color> out, RenderCounters &counters) const {
+        for (size_t i = 0; i < rays.size(); ++i) out[i] = Li(scene, rays[i], *samplers[i], counters);
+    }
     // Called between passes, single-threaded, after all samples of the pass are in.
     virtual void end_pass(const Scene &scene, const PassStatistics &pass) {}
     // Name and effective options, for the statistics file.

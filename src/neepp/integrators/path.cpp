@@ -1,5 +1,7 @@
 #include "neepp/integrators/path.h"
 
+#include <vector>
+
 #include "neepp/light_selection/factory.h"
 #include "neepp/materials/bsdf.h"
 #include "neepp/math/warp.h"
@@ -66,11 +68,9 @@ float PathIntegrator::emission_weight(const Light &light, const LightSampleConte
     return mis_power(prev_pdf, light_pdf);
 }
 
-Color PathIntegrator::sample_direct(const Scene &scene, const SurfaceInteraction &si, const LightSampleContext &ctx,
+Color PathIntegrator::sample_direct(const Scene &scene, const SurfaceInteraction &si, const SampledLight &sl, Vec2 u,
                                     const BSDF &bsdf, const Color &beta, Sampler &sampler,
                                     RenderCounters &counters) const {
-    SampledLight sl = light_sampler_->sample(ctx, sampler.next_1d());
-    Vec2 u = sampler.next_2d();
     if (!sl.light || sl.pmf <= 0) return Color(0.f);
     Color Le;
     DirectionSample ds = sl.light->sample_direction(si.p, u, Le);
@@ -89,65 +89,137 @@ Color PathIntegrator::sample_direct(const Scene &scene, const SurfaceInteraction
     return q.unoccluded * shadow_->visibility(scene, q, sampler, counters);
 }
 
-Color PathIntegrator::Li(const Scene &scene, const Ray &primary, Sampler &sampler, RenderCounters &counters) const {
-    Color L(0.f), beta(1.f);
+struct PathIntegrator::Path {
+    Sampler *sampler = nullptr;
+    Color L{0.f}, beta{1.f};
     float eta = 1.f;
-    Ray ray = primary;
-    LightSampleContext prev;       // the previous scattering vertex, for MIS on emitters hit
+    Ray ray;
+    int depth = 0;
+    LightSampleContext prev;   // the previous scattering vertex, for MIS on emitters hit
     float prev_bsdf_pdf = 1.f;
-    bool prev_delta = true;        // the camera counts as a delta vertex: no MIS on directly seen lights
-    const bool count_direct = !options_.hide_emitters;
+    bool prev_delta = true;    // the camera counts as a delta vertex: no MIS on directly seen lights
+    // The vertex being shaded: what the ray hit, and the light chosen for next event estimation there.
+    RayHit hit;
+    SurfaceInteraction si;
+    LightSampleContext ctx;
+    bool nee = false;
+    SampledLight light;
+    Vec2 u_light;
+};
 
-    for (int depth = 0;; ) {
-        SurfaceInteraction si;
-        ++counters.rays;
-        bool hit = scene.intersect(ray, si);
-        bool show_emission = depth > 0 || count_direct;
+void PathIntegrator::trace(const Scene &scene, Path &path, RenderCounters &counters) const {
+    ++counters.rays;
+    path.hit = scene.trace(path.ray);
+    scene.prefetch(path.hit, 0);
+}
 
-        if (!hit) {
-            if (show_emission)
-                for (const Light *env : scene.infinite_lights()) {
-                    Color Le = env->eval_environment(ray.d);
-                    if (is_black(Le)) continue;
-                    float w = prev_delta ? 1.f : emission_weight(*env, prev, direction_sample_from_miss(ray.d), prev_bsdf_pdf);
-                    L += beta * Le * w;
-                }
-            break;
-        }
-        if (const Light *area = si.shape->area_light; area && show_emission) {
-            Color Le = area->eval_surface(si, -ray.d);
-            if (!is_black(Le)) {
-                float w = prev_delta ? 1.f : emission_weight(*area, prev, direction_sample_from_hit(prev.p, si), prev_bsdf_pdf);
-                L += beta * Le * w;
+void PathIntegrator::prefetch(const Scene &scene, const Path &path) const { scene.prefetch(path.hit, 1); }
+
+bool PathIntegrator::begin_vertex(const Scene &scene, Path &path) const {
+    const bool show_emission = path.depth > 0 || !options_.hide_emitters;
+    const Ray &ray = path.ray;
+    if (!path.hit.valid()) {
+        if (show_emission)
+            for (const Light *env : scene.infinite_lights()) {
+                Color Le = env->eval_environment(ray.d);
+                if (is_black(Le)) continue;
+                float w = path.prev_delta ? 1.f
+                                          : emission_weight(*env, path.prev, direction_sample_from_miss(ray.d),
+                                                            path.prev_bsdf_pdf);
+                path.L += path.beta * Le * w;
             }
-        }
-        if (options_.max_depth >= 0 && depth + 1 >= options_.max_depth) break;
-
-        const BSDF &bsdf = *si.shape->bsdf;
-        const LightSampleContext ctx = light_context(si, ray.d);
-        if (options_.nee && bsdf.has_flag(BSDFSmooth))
-            L += sample_direct(scene, si, ctx, bsdf, beta, sampler, counters);
-
-        float u1 = sampler.next_1d();
-        Vec2 u2 = sampler.next_2d();
-        BSDFSample bs = bsdf.sample(BSDFContext{}, si, si.wi, u1, u2);
-        if (!bs.valid()) break;
-        beta *= bs.weight;
-        eta *= bs.eta;
-        prev = ctx;
-        prev_bsdf_pdf = bs.pdf;
-        prev_delta = (bs.sampled_flags & BSDFDelta) != 0;
-        ray = si.spawn_ray(si.to_world(bs.wo));
-        ++depth;
-
-        // Russian roulette on the throughput (times eta^2 so refraction does not trigger it), Mitsuba's rule.
-        if (depth >= options_.rr_depth) {
-            float q = std::min(max_component(beta) * eta * eta, 0.95f);
-            if (!(sampler.next_1d() < q)) break;
-            beta /= q;
-        }
-        if (max_component(beta) <= 0) break;
+        return false;
     }
+    SurfaceInteraction &si = path.si;
+    scene.fill(path.hit, ray, si);
+    if (const Light *area = si.shape->area_light; area && show_emission) {
+        Color Le = area->eval_surface(si, -ray.d);
+        if (!is_black(Le)) {
+            float w = path.prev_delta ? 1.f
+                                      : emission_weight(*area, path.prev, direction_sample_from_hit(path.prev.p, si),
+                                                        path.prev_bsdf_pdf);
+            path.L += path.beta * Le * w;
+        }
+    }
+    if (options_.max_depth >= 0 && path.depth + 1 >= options_.max_depth) return false;
+
+    const BSDF &bsdf = *si.shape->bsdf;
+    bsdf.prefetch(si);
+    path.ctx = light_context(si, ray.d);
+    path.nee = options_.nee && bsdf.has_flag(BSDFSmooth);
+    if (path.nee) {
+        path.light = light_sampler_->sample(path.ctx, path.sampler->next_1d());
+        path.u_light = path.sampler->next_2d();
+        if (path.light.light) path.light.light->prefetch_sample(path.u_light, 0);
+    }
+    return true;
+}
+
+void PathIntegrator::prefetch_light(const Path &path) const {
+    if (path.nee && path.light.light) path.light.light->prefetch_sample(path.u_light, 1);
+}
+
+bool PathIntegrator::finish_vertex(const Scene &scene, Path &path, RenderCounters &counters) const {
+    const SurfaceInteraction &si = path.si;
+    const BSDF &bsdf = *si.shape->bsdf;
+    Sampler &sampler = *path.sampler;
+    if (path.nee) path.L += sample_direct(scene, si, path.light, path.u_light, bsdf, path.beta, sampler, counters);
+
+    float u1 = sampler.next_1d();
+    Vec2 u2 = sampler.next_2d();
+    BSDFSample bs = bsdf.sample(BSDFContext{}, si, si.wi, u1, u2);
+    if (!bs.valid()) return false;
+    path.beta *= bs.weight;
+    path.eta *= bs.eta;
+    path.prev = path.ctx;
+    path.prev_bsdf_pdf = bs.pdf;
+    path.prev_delta = (bs.sampled_flags & BSDFDelta) != 0;
+    path.ray = si.spawn_ray(si.to_world(bs.wo));
+    ++path.depth;
+
+    // Russian roulette on the throughput (times eta^2 so refraction does not trigger it), Mitsuba's rule.
+    if (path.depth >= options_.rr_depth) {
+        float q = std::min(max_component(path.beta) * path.eta * path.eta, 0.95f);
+        if (!(sampler.next_1d() < q)) return false;
+        path.beta /= q;
+    }
+    return max_component(path.beta) > 0;
+}
+
+void PathIntegrator::Li_batch(const Scene &scene, std::span<const Ray> rays, std::span<Sampler *const> samplers,
+                              std::span<Color> out, RenderCounters &counters) const {
+    constexpr size_t kBatch = 32;
+    std::vector<Path> paths(std::min(kBatch, rays.size()));
+    std::vector<uint32_t> active(paths.size());
+    for (size_t base = 0; base < rays.size(); base += kBatch) {
+        const size_t n = std::min(kBatch, rays.size() - base);
+        for (size_t i = 0; i < n; ++i) {
+            paths[i] = Path{};
+            paths[i].ray = rays[base + i];
+            paths[i].sampler = samplers[base + i];
+            active[i] = uint32_t(i);
+        }
+        // Each stage runs over every live path before the next starts, so a prefetch issued for one path
+        // has the other paths' work to complete in.
+        for (size_t live = n; live > 0;) {
+            for (size_t k = 0; k < live; ++k) trace(scene, paths[active[k]], counters);
+            for (size_t k = 0; k < live; ++k) prefetch(scene, paths[active[k]]);
+            size_t shading = 0;
+            for (size_t k = 0; k < live; ++k)
+                if (begin_vertex(scene, paths[active[k]])) active[shading++] = active[k];
+            for (size_t k = 0; k < shading; ++k) prefetch_light(paths[active[k]]);
+            live = 0;
+            for (size_t k = 0; k < shading; ++k)
+                if (finish_vertex(scene, paths[active[k]], counters)) active[live++] = active[k];
+        }
+        for (size_t i = 0; i < n; ++i) out[base + i] = paths[i].L;
+    }
+}
+
+Color PathIntegrator::Li(const Scene &scene, const Ray &primary, Sampler &sampler, RenderCounters &counters) const {
+    Sampler *const samplers[1] = {&sampler};
+    Color L;
+    Li_batch(scene, std::span<const Ray>(&primary, 1), samplers, std::span<Color>(&L, 1), counters);
     return L;
 }
 

@@ -26,16 +26,31 @@ public:
     void end_pass(const Scene &scene, const PassStatistics &pass) override;
     nlohmann::json statistics() const override;
     Color Li(const Scene &scene, const Ray &ray, Sampler &sampler, RenderCounters &counters) const override;
+    // Paths of a batch advance in lockstep, one bounce at a time and stage by stage, each stage issuing
+    // cache prefetches that the next stage, reached after the other paths' work, finds complete: without
+    // it the render waits on misses (mesh data, textures, environment-map tables) as long as it traces.
+    // Same random numbers in the same order per path as Li, so the same result to the bit.
+    void Li_batch(const Scene &scene, std::span<const Ray> rays, std::span<Sampler *const> samplers,
+                  std::span<Color> out, RenderCounters &counters) const override;
     nlohmann::json describe() const override;
     const PathOptions &options() const { return options_; }
     const ShadowRayTester &shadow_rays() const { return *shadow_; }
     ShadowRayTester &shadow_rays() { return *shadow_; }
 
 private:
+    struct Path;  // one path's state between stages
+    // Stages of one bounce (see Li_batch). begin_vertex and finish_vertex return false when the path ends.
+    void trace(const Scene &scene, Path &path, RenderCounters &counters) const;
+    void prefetch(const Scene &scene, const Path &path) const;
+    bool begin_vertex(const Scene &scene, Path &path) const;
+    void prefetch_light(const Path &path) const;
+    bool finish_vertex(const Scene &scene, Path &path, RenderCounters &counters) const;
+
     // Radiance from light sources by light sampling at si, MIS-weighted against BSDF sampling and
     // multiplied by the path throughput beta (so contribution-aware shadow-ray policies see the sample's
     // full contribution).
-    Color sample_direct(const Scene &scene, const SurfaceInteraction &si, const LightSampleContext &ctx,
+    // The light (sl) and its sample's random numbers (u) were drawn at begin_vertex.
+    Color sample_direct(const Scene &scene, const SurfaceInteraction &si, const SampledLight &sl, Vec2 u,
                         const class BSDF &bsdf, const Color &beta, Sampler &sampler, RenderCounters &counters) const;
     // MIS weight for emission found by a BSDF-sampled ray leaving prev (pdf prev_pdf) toward light.
     float emission_weight(const Light &light, const LightSampleContext &prev, const DirectionSample &ds,

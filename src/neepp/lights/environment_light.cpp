@@ -117,13 +117,35 @@ Color EnvironmentMapLight::lookup(Vec2 uv) const {
 
 Color EnvironmentMapLight::eval_environment(const Vec3 &d) const { return lookup(direction_to_uv(d)) * scale_; }
 
-DirectionSample EnvironmentMapLight::sample_direction(const Vec3 &ref, Vec2 u, Color &radiance) const {
+Vec2 EnvironmentMapLight::sample_uv(Vec2 u, float &pdf_uv) const {
     Vec2 offset;
     float pmf;
-    uint32_t cell = cells_.sample(u, offset, &pmf);
+    const uint32_t cell = cells_.sample(u, offset, &pmf);
     const int w = sample_w_, h = sample_h_;
-    Vec2 uv((float(cell % w) + offset.x) / float(w), (float(cell / w) + offset.y) / float(h));
-    float pdf_uv = pmf * float(w) * float(h);
+    pdf_uv = pmf * float(w) * float(h);
+    return {(float(cell % w) + offset.x) / float(w), (float(cell / w) + offset.y) / float(h)};
+}
+
+void EnvironmentMapLight::prefetch_sample(Vec2 u, int level) const {
+    if (level == 0) {
+        cells_.prefetch(u);
+        return;
+    }
+    float pdf_uv;
+    const Vec2 uv = sample_uv(u, pdf_uv);
+    // The two texel rows of lookup(uv)'s bilinear footprint (each pair of texels is 12 bytes).
+    const int x = std::min(int(uv.x * float(width_)), width_ - 1);
+    const int y = std::min(int(uv.y * float(height_ - 1)), height_ - 1), y1 = std::min(y + 1, height_ - 1);
+    for (int row : {y, y1}) {
+        const size_t i = 3 * (size_t(row) * width_ + x);
+        if (!half_.empty()) __builtin_prefetch(&half_[i]);
+        else __builtin_prefetch(&float_[i]);
+    }
+}
+
+DirectionSample EnvironmentMapLight::sample_direction(const Vec3 &ref, Vec2 u, Color &radiance) const {
+    float pdf_uv;
+    const Vec2 uv = sample_uv(u, pdf_uv);
     DirectionSample ds;
     radiance = Color(0.f);
     float sin_theta = std::sin(uv.y * kPi);

@@ -16,6 +16,7 @@ public:
     EnvironmentMapLight(Image image, const Transform &to_world, float scale);
     DirectionSample sample_direction(const Vec3 &ref, Vec2 u, Color &radiance) const override;
     float pdf_direction(const Vec3 &ref, const DirectionSample &ds) const override;
+    void prefetch_sample(Vec2 u, int level) const override;
     Color eval_environment(const Vec3 &d) const override;
     Color power() const override;
     bool is_infinite() const override { return true; }
@@ -27,6 +28,8 @@ public:
 
 private:
     Color lookup(Vec2 uv) const;
+    // The map point sample_direction(u) picks and its density in uv (0 where nothing can be sampled).
+    Vec2 sample_uv(Vec2 u, float &pdf_uv) const;
     Color texel(int x, int y) const;
     // Texels as half floats (RGB, 6 bytes): a 2k map is 12.6 MB instead of 25 MB, so with the sampling
     // table it stays in the last-level cache, where float texels made every sampled direction a miss to

@@ -151,6 +151,15 @@ Color BitmapTexture::interpolate(Vec2 uv) const {
     return out;
 }
 
+void BitmapTexture::prefetch(const SurfaceInteraction &si) const {
+    const Lookup l = locate(to_uv_.apply(si.uv));  // both rows of the bilinear footprint (nearest: a subset)
+    for (int y : {l.y0, l.y1}) {
+        const size_t i = (size_t(y) * width_ + l.x0) * channels_;
+        if (!codes_.empty()) __builtin_prefetch(&codes_[i]);
+        else __builtin_prefetch(&texels_[i]);
+    }
+}
+
 Color BitmapTexture::eval(const SurfaceInteraction &si) const { return interpolate(to_uv_.apply(si.uv)); }
 
 float BitmapTexture::eval_1(const SurfaceInteraction &si) const {

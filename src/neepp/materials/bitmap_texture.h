@@ -62,6 +62,7 @@ public:
     // the resolution after the to_uv transpose.
     Vec2 eval_1_grad(const SurfaceInteraction &si) const override;
     Color mean() const override { return Color(mean_); }
+    void prefetch(const SurfaceInteraction &si) const override;
     Color mean_rgb() const { return mean_rgb_; }
 
     int width() const { return width_; }

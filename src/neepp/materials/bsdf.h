@@ -60,6 +60,9 @@ public:
     virtual BSDFSample sample(const BSDFContext &ctx, const SurfaceInteraction &si, const Vec3 &wi, float u1,
                               Vec2 u2) const = 0;
     virtual uint32_t flags() const = 0;
+    // Cache prefetch of the texture data that evaluating or sampling at si (seen from si.wi) will read.
+    // A hint for batched integrators, issued well before shading; it never changes a result.
+    virtual void prefetch(const SurfaceInteraction &si) const {}
     bool has_flag(uint32_t f) const { return (flags() & f) != 0; }
 };
 

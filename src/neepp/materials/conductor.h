@@ -18,6 +18,7 @@ public:
     BSDFSample sample(const BSDFContext &ctx, const SurfaceInteraction &si, const Vec3 &wi, float u1,
                       Vec2 u2) const override;
     uint32_t flags() const override { return BSDFDeltaReflection; }
+    void prefetch(const SurfaceInteraction &si) const override { prefetch_textures(si, eta_, k_, specular_reflectance_); }
 
 private:
     TexturePtr eta_, k_, specular_reflectance_;

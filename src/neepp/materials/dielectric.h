@@ -20,6 +20,7 @@ public:
     BSDFSample sample(const BSDFContext &ctx, const SurfaceInteraction &si, const Vec3 &wi, float u1,
                       Vec2 u2) const override;
     uint32_t flags() const override { return BSDFDeltaReflection | BSDFDeltaTransmission; }
+    void prefetch(const SurfaceInteraction &si) const override { prefetch_textures(si, specular_reflectance_, specular_transmittance_); }
     float eta() const { return eta_; }
 
 private:

@@ -12,6 +12,7 @@ public:
     BSDFSample sample(const BSDFContext &, const SurfaceInteraction &si, const Vec3 &wi, float u1,
                       Vec2 u2) const override;
     uint32_t flags() const override { return BSDFDiffuseReflection; }
+    void prefetch(const SurfaceInteraction &si) const override { prefetch_textures(si, reflectance_); }
     const TexturePtr &reflectance() const { return reflectance_; }
 
 private:

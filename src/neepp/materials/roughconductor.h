@@ -24,6 +24,7 @@ public:
     BSDFSample sample(const BSDFContext &, const SurfaceInteraction &si, const Vec3 &wi, float u1,
                       Vec2 u2) const override;
     uint32_t flags() const override { return BSDFGlossyReflection; }
+    void prefetch(const SurfaceInteraction &si) const override { prefetch_textures(si, alpha_u_, alpha_v_, eta_, k_, specular_reflectance_); }
 
 private:
     MicrofacetDistribution distribution(const SurfaceInteraction &si) const;

@@ -19,7 +19,15 @@ public:
     // Average value over the texture's domain (for light power estimates and plastic's sampling weights).
     virtual Color mean() const = 0;
     virtual bool is_constant() const { return false; }
+    // Cache prefetch of what eval(si) will read (see BSDF::prefetch).
+    virtual void prefetch(const SurfaceInteraction &) const {}
 };
+
+// Prefetches each texture that is set (textures of a BSDF may be null when unused).
+template <class... T>
+void prefetch_textures(const SurfaceInteraction &si, const T &...textures) {
+    ((textures ? textures->prefetch(si) : void()), ...);
+}
 
 class ConstantTexture final : public Texture {
 public:

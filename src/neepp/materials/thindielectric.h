@@ -21,6 +21,7 @@ public:
     BSDFSample sample(const BSDFContext &ctx, const SurfaceInteraction &si, const Vec3 &wi, float u1,
                       Vec2 u2) const override;
     uint32_t flags() const override { return BSDFDeltaReflection | BSDFNull; }
+    void prefetch(const SurfaceInteraction &si) const override { prefetch_textures(si, specular_reflectance_, specular_transmittance_); }
 
     // Slab reflectance R' for light arriving from wi (Mitsuba's eval_null_transmission is 1 - R' times
     // specular_transmittance: what a shadow ray passing through the pane keeps).

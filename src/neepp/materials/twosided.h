@@ -13,6 +13,7 @@ public:
     BSDFSample sample(const BSDFContext &ctx, const SurfaceInteraction &si, const Vec3 &wi, float u1,
                       Vec2 u2) const override;
     uint32_t flags() const override { return front_->flags() | back_->flags(); }
+    void prefetch(const SurfaceInteraction &si) const override { (si.wi.z >= 0 ? front_ : back_)->prefetch(si); }
 
 private:
     BSDFPtr front_, back_;
@@ -28,6 +29,10 @@ public:
     BSDFSample sample(const BSDFContext &ctx, const SurfaceInteraction &si, const Vec3 &wi, float u1,
                       Vec2 u2) const override;
     uint32_t flags() const override { return nested_->flags() | BSDFNull; }
+    void prefetch(const SurfaceInteraction &si) const override {
+        opacity_->prefetch(si);
+        nested_->prefetch(si);
+    }
 
 private:
     float opacity(const SurfaceInteraction &si) const { return std::clamp(opacity_->eval_1(si), 0.f, 1.f); }
@@ -46,6 +51,10 @@ public:
     BSDFSample sample(const BSDFContext &ctx, const SurfaceInteraction &si, const Vec3 &wi, float u1,
                       Vec2 u2) const override;
     uint32_t flags() const override { return nested_->flags(); }
+    void prefetch(const SurfaceInteraction &si) const override {  // the perturbed frame keeps si's uv
+        height_->prefetch(si);
+        nested_->prefetch(si);
+    }
     // The perturbed shading frame, in world space.
     Frame perturbed_frame(const SurfaceInteraction &si) const;
 

@@ -114,11 +114,8 @@ AliasTable::AliasTable(const std::vector<float> &weights) {
 }
 
 uint32_t AliasTable::sample(Vec2 u, Vec2 &offset, float *pmf_out) const {
-    // 48 random bits: the 24 mantissa bits of each sampler dimension.
-    uint64_t bits = (uint64_t(double(u.x) * 0x1p24) << 24) | uint64_t(double(u.y) * 0x1p24);
-    unsigned __int128 scaled = (unsigned __int128)bits * bins_.size();
-    uint32_t i = uint32_t(scaled >> 48);
-    double frac = double(uint64_t(scaled) & ((uint64_t(1) << 48) - 1)) * 0x1p-48;
+    double frac;
+    uint32_t i = first_bin(u, frac);
     const Bin &b = bins_[i];
     double rest;
     if (frac < b.threshold) {

@@ -19,6 +19,9 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
+// Camera samples handed to the integrator at once (Integrator::Li_batch).
+constexpr int kBatch = 32;
+
 struct Tile {
     int x0, y0, w, h;
 };
@@ -117,7 +120,13 @@ RenderResult render(const Scene &scene, Integrator &integrator, const RenderJob 
         const double pass_start = elapsed();
         arena.execute([&] {
             tbb::parallel_for(tbb::blocked_range<size_t>(0, tiles.size(), 1), [&](const tbb::blocked_range<size_t> &r) {
-                std::unique_ptr<Sampler> sampler = prototype->clone();
+                // Samples go to the integrator in batches (see Integrator::Li_batch), each with its own sampler.
+                std::vector<std::unique_ptr<Sampler>> owned;
+                std::vector<Sampler *> samplers;
+                for (int k = 0; k < kBatch; ++k) samplers.push_back(owned.emplace_back(prototype->clone()).get());
+                std::vector<Ray> rays(kBatch);
+                std::vector<Vec2> film_pos(kBatch);
+                std::vector<Color> radiance(kBatch);
                 RenderCounters &c = counters.local();
                 for (size_t ti = r.begin(); ti != r.end(); ++ti) {
                     if (aborted.load(std::memory_order_relaxed)) return;
@@ -132,23 +141,35 @@ RenderResult render(const Scene &scene, Integrator &integrator, const RenderJob 
                     const Tile &t = tiles[ti];
                     double m2 = 0;
                     ImageBlock block(t.x0 - border, t.y0 - border, t.w + 2 * border, t.h + 2 * border, &filter);
+                    int queued = 0;
+                    auto flush = [&] {
+                        integrator.Li_batch(scene, std::span<const Ray>(rays.data(), queued),
+                                            std::span<Sampler *const>(samplers.data(), queued),
+                                            std::span<Color>(radiance.data(), queued), c);
+                        for (int k = 0; k < queued; ++k) {
+                            Color L = radiance[k];
+                            // Only NaN/inf are dropped: negative values are legitimate for unbiased
+                            // estimators such as NEE++'s control variate and must average out.
+                            if (!is_finite(L)) {
+                                ++c.invalid_samples;
+                                L = Color(0.f);
+                            }
+                            block.put(film_pos[k].x, film_pos[k].y, L);
+                            m2 += double(luminance(L)) * double(luminance(L));
+                        }
+                        queued = 0;
+                    };
                     for (int y = t.y0; y < t.y0 + t.h; ++y)
                         for (int x = t.x0; x < t.x0 + t.w; ++x)
                             for (int s = s0; s < s0 + size; ++s) {
-                                sampler->start_sample(uint32_t(x), uint32_t(y), uint32_t(s));
-                                Vec2 jitter = sampler->next_2d();
-                                float px = float(x) + jitter.x, py = float(y) + jitter.y;
-                                Ray ray = cam.generate_ray({px / float(W), py / float(H)});
-                                Color L = integrator.Li(scene, ray, *sampler, c);
-                                // Only NaN/inf are dropped: negative values are legitimate for unbiased
-                                // estimators such as NEE++'s control variate and must average out.
-                                if (!is_finite(L)) {
-                                    ++c.invalid_samples;
-                                    L = Color(0.f);
-                                }
-                                block.put(px, py, L);
-                                m2 += double(luminance(L)) * double(luminance(L));
+                                Sampler &sampler = *samplers[queued];
+                                sampler.start_sample(uint32_t(x), uint32_t(y), uint32_t(s));
+                                Vec2 jitter = sampler.next_2d();
+                                film_pos[queued] = Vec2(float(x) + jitter.x, float(y) + jitter.y);
+                                rays[queued] = cam.generate_ray({film_pos[queued].x / float(W), film_pos[queued].y / float(H)});
+                                if (++queued == kBatch) flush();
                             }
+                    if (queued > 0) flush();
                     tile_m2[ti] = m2;
                     std::lock_guard<std::mutex> lock(merge_mutex);
                     pass_block.merge(block);

@@ -87,7 +87,7 @@ void Scene::build() {
     }
 }
 
-bool Scene::intersect(const Ray &ray, SurfaceInteraction &si) const {
+RayHit Scene::trace(const Ray &ray) const {
     RTCIntersectContext ctx;
     rtcInitIntersectContext(&ctx);
     RTCRayHit rh;
@@ -98,14 +98,29 @@ bool Scene::intersect(const Ray &ray, SurfaceInteraction &si) const {
     rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
     rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
     rtcIntersect1(rtc_scene_, &ctx, &rh);
-    if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) {
+    RayHit hit;
+    if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return hit;
+    hit.t = rh.ray.tfar, hit.u = rh.hit.u, hit.v = rh.hit.v;
+    hit.geom = rh.hit.geomID, hit.prim = rh.hit.primID;
+    return hit;
+}
+
+void Scene::prefetch(const RayHit &hit, int level) const {
+    if (hit.valid()) shapes_[hit.geom]->prefetch(hit.prim, level);
+}
+
+void Scene::fill(const RayHit &hit, const Ray &ray, SurfaceInteraction &si) const {
+    shapes_[hit.geom]->fill_interaction(hit.prim, hit.u, hit.v, ray, hit.t, si);
+    si.wi = si.to_local(-ray.d);
+}
+
+bool Scene::intersect(const Ray &ray, SurfaceInteraction &si) const {
+    const RayHit hit = trace(ray);
+    if (!hit.valid()) {
         si.shape = nullptr;
         return false;
     }
-    const Shape &s = *shapes_[rh.hit.geomID];
-    s.fill_interaction(rh.hit.primID, rh.hit.u, rh.hit.v, ray,
-                       rh.ray.tfar, si);
-    si.wi = si.to_local(-ray.d);
+    fill(hit, ray, si);
     return true;
 }
 

@@ -23,6 +23,16 @@ struct RenderSettings {
     float rfilter_stddev = 0.5f;
 };
 
+// What Embree reports for a ray before the hit record is filled in. Kept apart so that a batch of paths
+// can trace all its rays first and fill their hit records after the mesh data those need has been
+// prefetched: filling is otherwise a chain of cache misses (indices, then vertices) that stalls the core.
+struct RayHit {
+    static constexpr uint32_t kNone = ~0u;
+    float t = kInfinity, u = 0, v = 0;
+    uint32_t geom = kNone, prim = 0;
+    bool valid() const { return geom != kNone; }
+};
+
 class Scene {
 public:
     Scene();
@@ -36,7 +46,12 @@ public:
     // Finalizes shapes, builds the Embree scene and tells lights the scene bounds. Throws on an empty scene.
     void build();
 
-    bool intersect(const Ray &ray, SurfaceInteraction &si) const;
+    bool intersect(const Ray &ray, SurfaceInteraction &si) const;  // trace + fill
+    RayHit trace(const Ray &ray) const;
+    // Prefetches what fill() will read for hit: level 0 what the hit alone locates (a triangle's
+    // indices), level 1 what level 0 brought in locates (its vertex data). A hint: no effect on results.
+    void prefetch(const RayHit &hit, int level) const;
+    void fill(const RayHit &hit, const Ray &ray, SurfaceInteraction &si) const;
     bool occluded(const Ray &ray) const;
 
     const std::vector<std::unique_ptr<Shape>> &shapes() const { return shapes_; }

@@ -51,6 +51,8 @@ struct Shape {
     // Completes a hit record from Embree's primitive index and barycentrics (or sphere hit).
     void fill_interaction(uint32_t prim, float b1, float b2, const Ray &ray, float t,
                           SurfaceInteraction &si) const;
+    // Cache prefetch of what fill_interaction(prim) reads: level 0 the indices, level 1 the vertex data.
+    void prefetch(uint32_t prim, int level) const;
 
 private:
     float area_ = 0;
