@@ -107,12 +107,6 @@ struct PathIntegrator::Path {
     Vec2 u_light;
 };
 
-void PathIntegrator::trace(const Scene &scene, Path &path, RenderCounters &counters) const {
-    ++counters.rays;
-    path.hit = scene.trace(path.ray);
-    scene.prefetch(path.hit, 0);
-}
-
 void PathIntegrator::prefetch(const Scene &scene, const Path &path) const { scene.prefetch(path.hit, 1); }
 
 bool PathIntegrator::begin_vertex(const Scene &scene, Path &path) const {
@@ -202,7 +196,17 @@ void PathIntegrator::Li_batch(const Scene &scene, std::span<const Ray> rays, std
         // Each stage runs over every live path before the next starts, so a prefetch issued for one path
         // has the other paths' work to complete in.
         for (size_t live = n; live > 0;) {
-            for (size_t k = 0; k < live; ++k) trace(scene, paths[active[k]], counters);
+            // Rays go to Embree as packets of 16 (its widest on AVX-512), as Mitsuba's vectorized variants
+            // trace them: cheaper per ray than one at a time, most of all for a tile's coherent camera rays.
+            for (size_t k0 = 0; k0 < live; k0 += 16) {
+                const Ray *rs[16];
+                RayHit *hs[16];
+                const int m = int(std::min<size_t>(16, live - k0));
+                for (int j = 0; j < m; ++j) rs[j] = &paths[active[k0 + j]].ray, hs[j] = &paths[active[k0 + j]].hit;
+                scene.trace16(rs, hs, m);
+                counters.rays += m;
+                for (int j = 0; j < m; ++j) scene.prefetch(*hs[j], 0);
+            }
             for (size_t k = 0; k < live; ++k) prefetch(scene, paths[active[k]]);
             size_t shading = 0;
             for (size_t k = 0; k < live; ++k)

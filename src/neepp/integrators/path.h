@@ -40,7 +40,6 @@ public:
 private:
     struct Path;  // one path's state between stages
     // Stages of one bounce (see Li_batch). begin_vertex and finish_vertex return false when the path ends.
-    void trace(const Scene &scene, Path &path, RenderCounters &counters) const;
     void prefetch(const Scene &scene, const Path &path) const;
     bool begin_vertex(const Scene &scene, Path &path) const;
     void prefetch_light(const Path &path) const;

@@ -9,6 +9,7 @@
 #include <tbb/parallel_for.h>
 #include <tbb/task_arena.h>
 #include "neepp/integrators/integrator.h"
+#include "neepp/math/denormals.h"
 #include "neepp/render/film.h"
 #include "neepp/render/progress_bar.h"
 #include "neepp/sampling/sampler.h"
@@ -120,6 +121,7 @@ RenderResult render(const Scene &scene, Integrator &integrator, const RenderJob 
         const double pass_start = elapsed();
         arena.execute([&] {
             tbb::parallel_for(tbb::blocked_range<size_t>(0, tiles.size(), 1), [&](const tbb::blocked_range<size_t> &r) {
+                const DenormalsAreZero ftz;
                 // Samples go to the integrator in batches (see Integrator::Li_batch), each with its own sampler.
                 std::vector<std::unique_ptr<Sampler>> owned;
                 std::vector<Sampler *> samplers;

@@ -105,6 +105,31 @@ RayHit Scene::trace(const Ray &ray) const {
     return hit;
 }
 
+void Scene::trace16(const Ray *const *rays, RayHit *const *hits, int n) const {
+    RTCIntersectContext ctx;
+    rtcInitIntersectContext(&ctx);
+    alignas(64) int valid[16];
+    alignas(64) RTCRayHit16 rh;
+    for (int i = 0; i < 16; ++i) {
+        valid[i] = i < n ? -1 : 0;
+        const Ray &ray = *rays[i < n ? i : 0];
+        rh.ray.org_x[i] = ray.o.x; rh.ray.org_y[i] = ray.o.y; rh.ray.org_z[i] = ray.o.z;
+        rh.ray.dir_x[i] = ray.d.x; rh.ray.dir_y[i] = ray.d.y; rh.ray.dir_z[i] = ray.d.z;
+        rh.ray.tnear[i] = ray.tmin; rh.ray.tfar[i] = ray.tmax;
+        rh.ray.time[i] = 0; rh.ray.mask[i] = 0xFFFFFFFFu; rh.ray.id[i] = 0; rh.ray.flags[i] = 0;
+        rh.hit.geomID[i] = RTC_INVALID_GEOMETRY_ID;
+        rh.hit.instID[0][i] = RTC_INVALID_GEOMETRY_ID;
+    }
+    rtcIntersect16(valid, rtc_scene_, &ctx, &rh);
+    for (int i = 0; i < n; ++i) {
+        RayHit &hit = *hits[i];
+        hit = RayHit();
+        if (rh.hit.geomID[i] == RTC_INVALID_GEOMETRY_ID) continue;
+        hit.t = rh.ray.tfar[i], hit.u = rh.hit.u[i], hit.v = rh.hit.v[i];
+        hit.geom = rh.hit.geomID[i], hit.prim = rh.hit.primID[i];
+    }
+}
+
 void Scene::prefetch(const RayHit &hit, int level) const {
     if (hit.valid()) shapes_[hit.geom]->prefetch(hit.prim, level);
 }

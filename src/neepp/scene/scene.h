@@ -48,6 +48,8 @@ public:
 
     bool intersect(const Ray &ray, SurfaceInteraction &si) const;  // trace + fill
     RayHit trace(const Ray &ray) const;
+    // trace() of up to 16 rays at once, as one Embree packet.
+    void trace16(const Ray *const *rays, RayHit *const *hits, int n) const;
     // Prefetches what fill() will read for hit: level 0 what the hit alone locates (a triangle's
     // indices), level 1 what level 0 brought in locates (its vertex data). A hint: no effect on results.
     void prefetch(const RayHit &hit, int level) const;

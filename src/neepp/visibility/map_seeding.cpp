@@ -3,6 +3,7 @@
 #include <chrono>
 #include <stdexcept>
 #include <tbb/parallel_for.h>
+#include "neepp/math/denormals.h"
 #include "neepp/math/frame.h"
 #include "neepp/math/warp.h"
 #include "neepp/sampling/rng.h"
@@ -60,6 +61,7 @@ SeedingStats seed_visibility_map(const Scene &scene, const VoxelGrid &grid, Visi
     std::vector<CellPoint> path_points(paths * B);
     std::vector<uint8_t> path_len(paths, 0);
     tbb::parallel_for(tbb::blocked_range<size_t>(0, paths, 256), [&](const tbb::blocked_range<size_t> &r) {
+        const DenormalsAreZero ftz;
         for (size_t i = r.begin(); i != r.end(); ++i) {
             PCG32 rng(mix_bits(opt.seed ^ mix_bits(i)), 1);
             Vec2 film{(float(i % G) + rng.next_float()) / float(G), (float(i / G) + rng.next_float()) / float(G)};
@@ -123,6 +125,7 @@ SeedingStats seed_visibility_map(const Scene &scene, const VoxelGrid &grid, Visi
             if (a != b) jobs.push_back({a, b});
     std::vector<PairCounts> results(jobs.size());
     tbb::parallel_for(tbb::blocked_range<size_t>(0, jobs.size(), 16), [&](const tbb::blocked_range<size_t> &r) {
+        const DenormalsAreZero ftz;
         for (size_t j = r.begin(); j != r.end(); ++j) {
             const auto &xs = surface.items[jobs[j].a];
             const auto &ys = light_ends.items[jobs[j].b];

@@ -1,0 +1,62 @@
+// Scene queries: a packet of rays (trace16, full or partial) finds the same hits as one ray at a time,
+// and trace + fill gives the hit record intersect gives.
+#include <gtest/gtest.h>
+#include "neepp/sampling/rng.h"
+#include "neepp/math/warp.h"
+#include "neepp/scene/scene.h"
+#include "test_scenes.h"
+
+using namespace neepp;
+using namespace neepp::testing;
+
+namespace {
+
+std::unique_ptr<Scene> boxes_scene() {
+    return load_scene(write_temp_scene(scene_header_xml(4, 60, "0,1,3", "0,0.5,0", 8, 8) + R"(
+  <bsdf type="diffuse" id="white"/>
+  <shape type="cube"><transform name="to_world"><scale value="0.5"/></transform><ref id="white"/></shape>
+  <shape type="cube"><transform name="to_world"><scale value="0.3"/><translate x="1" y="0.6"/></transform><ref id="white"/></shape>
+  <shape type="sphere"><point name="center" x="-1" y="0.4" z="0"/><float name="radius" value="0.4"/><ref id="white"/></shape>
+  <shape type="rectangle"><transform name="to_world"><scale value="3"/><rotate x="1" angle="-90"/><translate y="-0.5"/></transform><ref id="white"/></shape>
+  <emitter type="constant"/>
+</scene>)"));
+}
+
+TEST(SceneTrace, PacketsFindTheSameHitsAsSingleRays) {
+    auto scene = boxes_scene();
+    PCG32 rng;
+    rng.seed(3, 5);
+    int hits = 0;
+    for (int n : {16, 7, 1}) {
+        for (int round = 0; round < 200; ++round) {
+            std::vector<Ray> rays(n);
+            std::vector<RayHit> packet(n);
+            std::vector<const Ray *> rp(n);
+            std::vector<RayHit *> hp(n);
+            for (int i = 0; i < n; ++i) {
+                Vec3 o(rng.next_float() * 4 - 2, rng.next_float() * 2, rng.next_float() * 4 - 2);
+                rays[i] = Ray{o, square_to_uniform_sphere(rng.next_2d()), 0.f, i % 3 == 0 ? 1.5f : kInfinity};
+                rp[i] = &rays[i], hp[i] = &packet[i];
+            }
+            scene->trace16(rp.data(), hp.data(), n);
+            for (int i = 0; i < n; ++i) {
+                const RayHit single = scene->trace(rays[i]);
+                ASSERT_EQ(single.valid(), packet[i].valid()) << "ray " << i << " of " << n;
+                if (!single.valid()) continue;
+                ++hits;
+                EXPECT_EQ(single.geom, packet[i].geom);
+                EXPECT_EQ(single.prim, packet[i].prim);
+                EXPECT_NEAR(single.t, packet[i].t, 1e-5f * (1 + single.t));
+                EXPECT_LE(packet[i].t, rays[i].tmax);
+                SurfaceInteraction a, b;
+                ASSERT_TRUE(scene->intersect(rays[i], a));
+                scene->fill(packet[i], rays[i], b);
+                EXPECT_NEAR(norm(a.p - b.p), 0.f, 1e-4f);
+                EXPECT_EQ(a.shape, b.shape);
+            }
+        }
+    }
+    EXPECT_GT(hits, 1000);  // most rays start among the shapes and hit something
+}
+
+}  // namespace
