@@ -1,5 +1,5 @@
-// Scene queries: a packet of rays (trace16, full or partial) finds the same hits as one ray at a time,
-// and trace + fill gives the hit record intersect gives.
+// Scene queries: a packet of rays (trace16, occluded16; full or partial) finds the same hits as one ray
+// at a time, and trace + fill gives the hit record intersect gives.
 #include <gtest/gtest.h>
 #include "neepp/sampling/rng.h"
 #include "neepp/math/warp.h"
@@ -39,6 +39,9 @@ TEST(SceneTrace, PacketsFindTheSameHitsAsSingleRays) {
                 rp[i] = &rays[i], hp[i] = &packet[i];
             }
             scene->trace16(rp.data(), hp.data(), n);
+            bool occluded[16];
+            scene->occluded16(rp.data(), n, occluded);
+            for (int i = 0; i < n; ++i) ASSERT_EQ(occluded[i], scene->occluded(rays[i])) << "ray " << i << " of " << n;
             for (int i = 0; i < n; ++i) {
                 const RayHit single = scene->trace(rays[i]);
                 ASSERT_EQ(single.valid(), packet[i].valid()) << "ray " << i << " of " << n;

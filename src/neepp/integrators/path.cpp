@@ -68,27 +68,6 @@ float PathIntegrator::emission_weight(const Light &light, const LightSampleConte
     return mis_power(prev_pdf, light_pdf);
 }
 
-Color PathIntegrator::sample_direct(const Scene &scene, const SurfaceInteraction &si, const SampledLight &sl, Vec2 u,
-                                    const BSDF &bsdf, const Color &beta, Sampler &sampler,
-                                    RenderCounters &counters) const {
-    if (!sl.light || sl.pmf <= 0) return Color(0.f);
-    Color Le;
-    DirectionSample ds = sl.light->sample_direction(si.p, u, Le);
-    if (!(ds.pdf > 0) || is_black(Le)) return Color(0.f);
-    Vec3 wo = si.to_local(ds.d);
-    BSDFContext bctx;
-    Color f = bsdf.eval(bctx, si, si.wi, wo);
-    if (is_black(f)) return Color(0.f);
-    float light_pdf = ds.pdf * sl.pmf;
-    float w = ds.delta ? 1.f : mis_power(light_pdf, bsdf.pdf(bctx, si, si.wi, wo));
-    ShadowQuery q;
-    q.ray = ds.dist >= kInfinity ? si.spawn_ray(ds.d) : si.spawn_ray_to(ds.p);
-    q.from = si.p;
-    q.to = ds.p;
-    q.unoccluded = beta * f * Le * (w / light_pdf);
-    return q.unoccluded * shadow_->visibility(scene, q, sampler, counters);
-}
-
 struct PathIntegrator::Path {
     Sampler *sampler = nullptr;
     Color L{0.f}, beta{1.f};
@@ -105,6 +84,9 @@ struct PathIntegrator::Path {
     bool nee = false;
     SampledLight light;
     Vec2 u_light;
+    // Next event estimation's shadow query, while its ray waits to be traced with the batch's others.
+    ShadowQuery shadow;
+    ShadowTest test;
 };
 
 void PathIntegrator::prefetch(const Scene &scene, const Path &path) const { scene.prefetch(path.hit, 1); }
@@ -153,12 +135,40 @@ void PathIntegrator::prefetch_light(const Path &path) const {
     if (path.nee && path.light.light) path.light.light->prefetch_sample(path.u_light, 1);
 }
 
-bool PathIntegrator::finish_vertex(const Scene &scene, Path &path, RenderCounters &counters) const {
+bool PathIntegrator::begin_direct(const Scene &scene, Path &path, RenderCounters &counters) const {
+    const SampledLight &sl = path.light;
+    if (!path.nee || !sl.light || sl.pmf <= 0) return false;
+    const SurfaceInteraction &si = path.si;
+    Color Le;
+    DirectionSample ds = sl.light->sample_direction(si.p, path.u_light, Le);
+    if (!(ds.pdf > 0) || is_black(Le)) return false;
+    Vec3 wo = si.to_local(ds.d);
+    const BSDF &bsdf = *si.shape->bsdf;
+    BSDFContext bctx;
+    Color f = bsdf.eval(bctx, si, si.wi, wo);
+    if (is_black(f)) return false;
+    float light_pdf = ds.pdf * sl.pmf;
+    float w = ds.delta ? 1.f : mis_power(light_pdf, bsdf.pdf(bctx, si, si.wi, wo));
+    ShadowQuery &q = path.shadow;
+    q.ray = ds.dist >= kInfinity ? si.spawn_ray(ds.d) : si.spawn_ray_to(ds.p);
+    q.from = si.p;
+    q.to = ds.p;
+    q.unoccluded = path.beta * f * Le * (w / light_pdf);
+    path.test = shadow_->begin_test(q, *path.sampler, counters);
+    if (path.test.trace) return true;
+    path.L += q.unoccluded * path.test.if_skipped;
+    return false;
+}
+
+void PathIntegrator::end_direct(Path &path, bool occluded) const {
+    shadow_->end_test(path.test, occluded);
+    path.L += path.shadow.unoccluded * path.test.weight(occluded);
+}
+
+bool PathIntegrator::finish_vertex(Path &path) const {
     const SurfaceInteraction &si = path.si;
     const BSDF &bsdf = *si.shape->bsdf;
     Sampler &sampler = *path.sampler;
-    if (path.nee) path.L += sample_direct(scene, si, path.light, path.u_light, bsdf, path.beta, sampler, counters);
-
     float u1 = sampler.next_1d();
     Vec2 u2 = sampler.next_2d();
     BSDFSample bs = bsdf.sample(BSDFContext{}, si, si.wi, u1, u2);
@@ -184,7 +194,7 @@ void PathIntegrator::Li_batch(const Scene &scene, std::span<const Ray> rays, std
                               std::span<Color> out, RenderCounters &counters) const {
     constexpr size_t kBatch = 32;
     std::vector<Path> paths(std::min(kBatch, rays.size()));
-    std::vector<uint32_t> active(paths.size());
+    std::vector<uint32_t> active(paths.size()), pending(paths.size());
     for (size_t base = 0; base < rays.size(); base += kBatch) {
         const size_t n = std::min(kBatch, rays.size() - base);
         for (size_t i = 0; i < n; ++i) {
@@ -212,9 +222,21 @@ void PathIntegrator::Li_batch(const Scene &scene, std::span<const Ray> rays, std
             for (size_t k = 0; k < live; ++k)
                 if (begin_vertex(scene, paths[active[k]])) active[shading++] = active[k];
             for (size_t k = 0; k < shading; ++k) prefetch_light(paths[active[k]]);
+            // Next event estimation: each policy decides, then the rays it asks for go out as packets.
+            size_t tracing = 0;
+            for (size_t k = 0; k < shading; ++k)
+                if (begin_direct(scene, paths[active[k]], counters)) pending[tracing++] = active[k];
+            for (size_t k0 = 0; k0 < tracing; k0 += 16) {
+                const Ray *rs[16];
+                bool occluded[16];
+                const int m = int(std::min<size_t>(16, tracing - k0));
+                for (int j = 0; j < m; ++j) rs[j] = &paths[pending[k0 + j]].shadow.ray;
+                trace_shadow_rays16(scene, rs, m, occluded, counters);
+                for (int j = 0; j < m; ++j) end_direct(paths[pending[k0 + j]], occluded[j]);
+            }
             live = 0;
             for (size_t k = 0; k < shading; ++k)
-                if (finish_vertex(scene, paths[active[k]], counters)) active[live++] = active[k];
+                if (finish_vertex(paths[active[k]])) active[live++] = active[k];
         }
         for (size_t i = 0; i < n; ++i) out[base + i] = paths[i].L;
     }

@@ -43,14 +43,16 @@ private:
     void prefetch(const Scene &scene, const Path &path) const;
     bool begin_vertex(const Scene &scene, Path &path) const;
     void prefetch_light(const Path &path) const;
-    bool finish_vertex(const Scene &scene, Path &path, RenderCounters &counters) const;
+    // Next event estimation at the vertex: begin_direct samples the light chosen at begin_vertex and asks
+    // the shadow-ray policy; it returns true when a ray must be traced, whose outcome end_direct takes.
+    bool begin_direct(const Scene &scene, Path &path, RenderCounters &counters) const;
+    void end_direct(Path &path, bool occluded) const;
+    // BSDF sampling and Russian roulette: the next ray, or false when the path ends.
+    bool finish_vertex(Path &path) const;
 
     // Radiance from light sources by light sampling at si, MIS-weighted against BSDF sampling and
     // multiplied by the path throughput beta (so contribution-aware shadow-ray policies see the sample's
     // full contribution).
-    // The light (sl) and its sample's random numbers (u) were drawn at begin_vertex.
-    Color sample_direct(const Scene &scene, const SurfaceInteraction &si, const SampledLight &sl, Vec2 u,
-                        const class BSDF &bsdf, const Color &beta, Sampler &sampler, RenderCounters &counters) const;
     // MIS weight for emission found by a BSDF-sampled ray leaving prev (pdf prev_pdf) toward light.
     float emission_weight(const Light &light, const LightSampleContext &prev, const DirectionSample &ds,
                           float prev_pdf) const;

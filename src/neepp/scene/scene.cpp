@@ -149,6 +149,23 @@ bool Scene::intersect(const Ray &ray, SurfaceInteraction &si) const {
     return true;
 }
 
+void Scene::occluded16(const Ray *const *rays, int n, bool *occluded) const {
+    RTCIntersectContext ctx;
+    rtcInitIntersectContext(&ctx);
+    alignas(64) int valid[16];
+    alignas(64) RTCRay16 r;
+    for (int i = 0; i < 16; ++i) {
+        valid[i] = i < n ? -1 : 0;
+        const Ray &ray = *rays[i < n ? i : 0];
+        r.org_x[i] = ray.o.x; r.org_y[i] = ray.o.y; r.org_z[i] = ray.o.z;
+        r.dir_x[i] = ray.d.x; r.dir_y[i] = ray.d.y; r.dir_z[i] = ray.d.z;
+        r.tnear[i] = ray.tmin; r.tfar[i] = ray.tmax;
+        r.time[i] = 0; r.mask[i] = 0xFFFFFFFFu; r.id[i] = 0; r.flags[i] = 0;
+    }
+    rtcOccluded16(valid, rtc_scene_, &ctx, &r);
+    for (int i = 0; i < n; ++i) occluded[i] = r.tfar[i] < 0;  // Embree sets tfar to -inf on a hit
+}
+
 bool Scene::occluded(const Ray &ray) const {
     RTCIntersectContext ctx;
     rtcInitIntersectContext(&ctx);

@@ -55,6 +55,7 @@ public:
     void prefetch(const RayHit &hit, int level) const;
     void fill(const RayHit &hit, const Ray &ray, SurfaceInteraction &si) const;
     bool occluded(const Ray &ray) const;
+    void occluded16(const Ray *const *rays, int n, bool *occluded) const;  // up to 16 rays, one packet
 
     const std::vector<std::unique_ptr<Shape>> &shapes() const { return shapes_; }
     const std::vector<LightPtr> &lights() const { return lights_; }

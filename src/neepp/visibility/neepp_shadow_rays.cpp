@@ -51,8 +51,7 @@ float NeeppShadowRays::trace_probability(PairCounts c, bool same_cell, float lum
     return std::min(1.f, std::max(v, options_.q_min));
 }
 
-float NeeppShadowRays::visibility(const Scene &scene, const ShadowQuery &q, Sampler &sampler,
-                                  RenderCounters &counters) const {
+ShadowTest NeeppShadowRays::begin_test(const ShadowQuery &q, Sampler &sampler, RenderCounters &counters) const {
     // Shadow rays toward environment lights are spawned with an infinite tmax; they are keyed by direction.
     const bool to_infinity = q.ray.tmax >= kInfinity;
     const uint32_t a = grid_.voxel_of(q.from);
@@ -60,16 +59,13 @@ float NeeppShadowRays::visibility(const Scene &scene, const ShadowQuery &q, Samp
     const uint64_t pair = VisibilityMap::pair_index(a, b);
     ThreadState &ts = threads_.local();
 
-    auto trace = [&] {
-        bool visible = !trace_shadow_ray(scene, q.ray, counters);
-        if (options_.learn) ts.updates.record(pair, visible);
-        return visible;
-    };
-    if (options_.policy == ShadowRayPolicy::TraceAll) return trace() ? 1.f : 0.f;  // learns, never reads the map
+    ShadowTest test;  // traced, weight V
+    if (options_.learn) test.learn_pair = pair;
+    if (options_.policy == ShadowRayPolicy::TraceAll) return test;  // learns, never reads the map
     const PairCounts c = map_.counts_at(pair);
     if (a == b || c.traced == 0) {
         ++(a == b ? ts.forced_same_cell : ts.forced_unknown);
-        return trace() ? 1.f : 0.f;
+        return test;
     }
 
     const float v = VisibilityMap::estimate(c);
@@ -90,18 +86,24 @@ float NeeppShadowRays::visibility(const Scene &scene, const ShadowQuery &q, Samp
     ts.q_sum_fixed += uint64_t(prob * kFixedOne);
     if (prob >= 1.f) {  // no roulette, no random number
         ++ts.roulette_traced;
-        return trace() ? 1.f : 0.f;  // q = 1: every policy's weight reduces to V
+        return test;  // q = 1: every policy's weight reduces to V
     }
-    const float u = sampler.next_1d();
-    if (u < prob) {
+    const bool cv = options_.policy == ShadowRayPolicy::NeeppCV;
+    if (sampler.next_1d() < prob) {
         ++ts.roulette_traced;
-        const float vis = trace() ? 1.f : 0.f;
-        if (options_.policy == ShadowRayPolicy::NeeppCV) return v + (vis - v) / prob;
-        return vis / prob;
+        test.if_visible = cv ? v + (1.f - v) / prob : 1.f / prob;
+        test.if_occluded = cv ? v - v / prob : 0.f;
+        return test;
     }
     ++ts.skipped;
     ++counters.shadow_rays_skipped;
-    return options_.policy == ShadowRayPolicy::NeeppCV ? v : 0.f;
+    test.trace = false;
+    test.if_skipped = cv ? v : 0.f;
+    return test;
+}
+
+void NeeppShadowRays::end_test(const ShadowTest &test, bool occluded) const {
+    if (test.learn_pair != ~uint64_t(0)) threads_.local().updates.record(test.learn_pair, !occluded);
 }
 
 void NeeppShadowRays::adopt_map(const VoxelGrid &grid, VisibilityMap map) {

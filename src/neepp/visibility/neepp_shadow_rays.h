@@ -63,7 +63,8 @@ struct NeeppOptions {
 class NeeppShadowRays final : public ShadowRayTester {
 public:
     explicit NeeppShadowRays(NeeppOptions options);
-    float visibility(const Scene &scene, const ShadowQuery &q, Sampler &sampler, RenderCounters &counters) const override;
+    ShadowTest begin_test(const ShadowQuery &q, Sampler &sampler, RenderCounters &counters) const override;
+    void end_test(const ShadowTest &test, bool occluded) const override;
     std::string policy() const override { return to_string(options_.policy); }
     void prepare(const Scene &scene) override;
     void end_pass(const PassStatistics &pass) override;

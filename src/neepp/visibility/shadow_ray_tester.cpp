@@ -13,9 +13,21 @@ bool trace_shadow_ray(const Scene &scene, const Ray &ray, RenderCounters &counte
     return blocked;
 }
 
-float TraceAllShadowRays::visibility(const Scene &scene, const ShadowQuery &q, Sampler &,
-                                     RenderCounters &counters) const {
-    return trace_shadow_ray(scene, q.ray, counters) ? 0.f : 1.f;
+void trace_shadow_rays16(const Scene &scene, const Ray *const *rays, int n, bool *occluded, RenderCounters &counters) {
+    uint64_t t0 = read_ticks();
+    scene.occluded16(rays, n, occluded);
+    counters.occlusion_ticks += read_ticks() - t0;
+    counters.shadow_rays += uint64_t(n);
+    for (int i = 0; i < n; ++i) counters.shadow_rays_occluded += occluded[i];
+}
+
+float ShadowRayTester::visibility(const Scene &scene, const ShadowQuery &q, Sampler &sampler,
+                                  RenderCounters &counters) const {
+    const ShadowTest test = begin_test(q, sampler, counters);
+    if (!test.trace) return test.if_skipped;
+    const bool occluded = trace_shadow_ray(scene, q.ray, counters);
+    end_test(test, occluded);
+    return test.weight(occluded);
 }
 
 }  // namespace neepp

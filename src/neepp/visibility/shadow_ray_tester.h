@@ -23,6 +23,16 @@ struct ShadowQuery {
     Color unoccluded;  // contribution if visible (throughput × f × Le / pdf, MIS included)
 };
 
+// A policy's decision on one query, taken before any ray is traced: whether to trace, and the weight of
+// each outcome. Splitting decision and outcome lets an integrator trace many queries' rays at once.
+struct ShadowTest {
+    bool trace = true;
+    float if_visible = 1.f, if_occluded = 0.f;  // weights when traced
+    float if_skipped = 0.f;                     // weight when not traced
+    uint64_t learn_pair = ~uint64_t(0);         // NEE++: the map pair the traced ray's outcome updates
+    float weight(bool occluded) const { return trace ? (occluded ? if_occluded : if_visible) : if_skipped; }
+};
+
 class ShadowRayTester {
 public:
     virtual ~ShadowRayTester() = default;
@@ -30,8 +40,12 @@ public:
     // rejected), 1 if visible, 1/q for a ray traced with probability q. Must be unbiased: E[weight] = V.
     // A policy that plays Russian roulette draws its one random number from sampler.next_1d(), and only
     // when a roulette actually happens. Called concurrently from the render threads.
-    virtual float visibility(const Scene &scene, const ShadowQuery &q, Sampler &sampler,
-                             RenderCounters &counters) const = 0;
+    // The same in two steps: begin_test decides (drawing the roulette's number), the caller traces
+    // q.ray if asked (trace_shadow_ray, or in a packet) and gives the outcome to end_test, which learns
+    // from it; the weight is then test.weight(occluded).
+    float visibility(const Scene &scene, const ShadowQuery &q, Sampler &sampler, RenderCounters &counters) const;
+    virtual ShadowTest begin_test(const ShadowQuery &q, Sampler &sampler, RenderCounters &counters) const = 0;
+    virtual void end_test(const ShadowTest &test, bool occluded) const {}
     virtual std::string policy() const = 0;
     // Hooks of the render loop, both single-threaded: prepare() before the first pass (build or load the
     // visibility map), end_pass() after each pass (merge what the pass learned; the next pass reads the
@@ -51,11 +65,13 @@ public:
 // Plain next event estimation: every shadow ray is traced.
 class TraceAllShadowRays final : public ShadowRayTester {
 public:
-    float visibility(const Scene &scene, const ShadowQuery &q, Sampler &sampler, RenderCounters &counters) const override;
+    ShadowTest begin_test(const ShadowQuery &, Sampler &, RenderCounters &) const override { return {}; }
     std::string policy() const override { return "nee"; }
 };
 
 // Traces one occlusion query and accounts for it; the building block of every policy.
 bool trace_shadow_ray(const Scene &scene, const Ray &ray, RenderCounters &counters);
+// The same for up to 16 rays as one Embree packet; occluded[i] receives ray i's answer.
+void trace_shadow_rays16(const Scene &scene, const Ray *const *rays, int n, bool *occluded, RenderCounters &counters);
 
 }  // namespace neepp
