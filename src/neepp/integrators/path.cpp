@@ -135,7 +135,7 @@ void PathIntegrator::prefetch_light(const Path &path) const {
     if (path.nee && path.light.light) path.light.light->prefetch_sample(path.u_light, 1);
 }
 
-bool PathIntegrator::begin_direct(const Scene &scene, Path &path, RenderCounters &counters) const {
+bool PathIntegrator::begin_direct(Path &path) const {
     const SampledLight &sl = path.light;
     if (!path.nee || !sl.light || sl.pmf <= 0) return false;
     const SurfaceInteraction &si = path.si;
@@ -154,9 +154,14 @@ bool PathIntegrator::begin_direct(const Scene &scene, Path &path, RenderCounters
     q.from = si.p;
     q.to = ds.p;
     q.unoccluded = path.beta * f * Le * (w / light_pdf);
-    path.test = shadow_->begin_test(q, *path.sampler, counters);
+    shadow_->prefetch(q);
+    return true;
+}
+
+bool PathIntegrator::decide_direct(Path &path, RenderCounters &counters) const {
+    path.test = shadow_->begin_test(path.shadow, *path.sampler, counters);
     if (path.test.trace) return true;
-    path.L += q.unoccluded * path.test.if_skipped;
+    path.L += path.shadow.unoccluded * path.test.if_skipped;
     return false;
 }
 
@@ -223,9 +228,11 @@ void PathIntegrator::Li_batch(const Scene &scene, std::span<const Ray> rays, std
                 if (begin_vertex(scene, paths[active[k]])) active[shading++] = active[k];
             for (size_t k = 0; k < shading; ++k) prefetch_light(paths[active[k]]);
             // Next event estimation: each policy decides, then the rays it asks for go out as packets.
-            size_t tracing = 0;
+            size_t querying = 0, tracing = 0;
             for (size_t k = 0; k < shading; ++k)
-                if (begin_direct(scene, paths[active[k]], counters)) pending[tracing++] = active[k];
+                if (begin_direct(paths[active[k]])) pending[querying++] = active[k];
+            for (size_t k = 0; k < querying; ++k)
+                if (decide_direct(paths[pending[k]], counters)) pending[tracing++] = pending[k];
             for (size_t k0 = 0; k0 < tracing; k0 += 16) {
                 const Ray *rs[16];
                 bool occluded[16];

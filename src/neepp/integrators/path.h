@@ -43,9 +43,11 @@ private:
     void prefetch(const Scene &scene, const Path &path) const;
     bool begin_vertex(const Scene &scene, Path &path) const;
     void prefetch_light(const Path &path) const;
-    // Next event estimation at the vertex: begin_direct samples the light chosen at begin_vertex and asks
-    // the shadow-ray policy; it returns true when a ray must be traced, whose outcome end_direct takes.
-    bool begin_direct(const Scene &scene, Path &path, RenderCounters &counters) const;
+    // Next event estimation at the vertex: begin_direct samples the light chosen at begin_vertex and forms
+    // the shadow query (false: the sample contributes nothing); decide_direct asks the shadow-ray policy
+    // and returns true when a ray must be traced, whose outcome end_direct takes.
+    bool begin_direct(Path &path) const;
+    bool decide_direct(Path &path, RenderCounters &counters) const;
     void end_direct(Path &path, bool occluded) const;
     // BSDF sampling and Russian roulette: the next ray, or false when the path ends.
     bool finish_vertex(Path &path) const;

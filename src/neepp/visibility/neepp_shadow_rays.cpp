@@ -51,11 +51,21 @@ float NeeppShadowRays::trace_probability(PairCounts c, bool same_cell, float lum
     return std::min(1.f, std::max(v, options_.q_min));
 }
 
-ShadowTest NeeppShadowRays::begin_test(const ShadowQuery &q, Sampler &sampler, RenderCounters &counters) const {
-    // Shadow rays toward environment lights are spawned with an infinite tmax; they are keyed by direction.
+// Shadow rays toward environment lights are spawned with an infinite tmax; they are keyed by direction.
+std::pair<uint32_t, uint32_t> NeeppShadowRays::cells_of(const ShadowQuery &q) const {
     const bool to_infinity = q.ray.tmax >= kInfinity;
-    const uint32_t a = grid_.voxel_of(q.from);
-    const uint32_t b = to_infinity ? grid_.cell_of_direction(q.ray.d) : grid_.voxel_of(q.to);
+    return {grid_.voxel_of(q.from), to_infinity ? grid_.cell_of_direction(q.ray.d) : grid_.voxel_of(q.to)};
+}
+
+void NeeppShadowRays::prefetch(const ShadowQuery &q) const {
+    const auto [a, b] = cells_of(q);
+    const uint64_t pair = VisibilityMap::pair_index(a, b);
+    if (options_.policy != ShadowRayPolicy::TraceAll) map_.prefetch(pair);
+    if (options_.learn) threads_.local().updates.prefetch(pair);
+}
+
+ShadowTest NeeppShadowRays::begin_test(const ShadowQuery &q, Sampler &sampler, RenderCounters &counters) const {
+    const auto [a, b] = cells_of(q);
     const uint64_t pair = VisibilityMap::pair_index(a, b);
     ThreadState &ts = threads_.local();
 

@@ -19,6 +19,7 @@
 #pragma once
 #include <memory>
 #include <string>
+#include <utility>
 #include <tbb/enumerable_thread_specific.h>
 #include "neepp/visibility/map_seeding.h"
 #include "neepp/visibility/shadow_ray_tester.h"
@@ -65,6 +66,7 @@ public:
     explicit NeeppShadowRays(NeeppOptions options);
     ShadowTest begin_test(const ShadowQuery &q, Sampler &sampler, RenderCounters &counters) const override;
     void end_test(const ShadowTest &test, bool occluded) const override;
+    void prefetch(const ShadowQuery &q) const override;
     std::string policy() const override { return to_string(options_.policy); }
     void prepare(const Scene &scene) override;
     void end_pass(const PassStatistics &pass) override;
@@ -106,6 +108,7 @@ private:
         uint64_t q_sum_fixed = 0, updates_merged = 0, passes = 0;
         double merge_time_s = 0;
     };
+    std::pair<uint32_t, uint32_t> cells_of(const ShadowQuery &q) const;  // (shading voxel, light cell)
     void calibrate_adaptive(const std::vector<uint64_t> &histogram, uint64_t roulettes, uint64_t paper_q_sum_fixed);
 
     NeeppOptions options_;

@@ -46,6 +46,9 @@ public:
     float visibility(const Scene &scene, const ShadowQuery &q, Sampler &sampler, RenderCounters &counters) const;
     virtual ShadowTest begin_test(const ShadowQuery &q, Sampler &sampler, RenderCounters &counters) const = 0;
     virtual void end_test(const ShadowTest &test, bool occluded) const {}
+    // Cache prefetch of what begin_test(q) and end_test will read and write (NEE++: the pair's map entry
+    // and update slot), for integrators that form many queries before deciding any. A hint only.
+    virtual void prefetch(const ShadowQuery &q) const {}
     virtual std::string policy() const = 0;
     // Hooks of the render loop, both single-threaded: prepare() before the first pass (build or load the
     // visibility map), end_pass() after each pass (merge what the pass learned; the next pass reads the

@@ -31,6 +31,7 @@ public:
 
     PairCounts counts(uint32_t a, uint32_t b) const { return counts_[pair_index(a, b)]; }
     PairCounts counts_at(uint64_t pair) const { return counts_[pair]; }
+    void prefetch(uint64_t pair) const { __builtin_prefetch(&counts_[pair]); }
     // Never traced: the policy must trace (and thereby learn) rather than guess.
     bool known(uint32_t a, uint32_t b) const { return counts(a, b).traced != 0; }
     // Ṽ = (visible + 1) / (traced + 2): a weak Beta(1,1) prior, so the estimate is never exactly 0 or 1
