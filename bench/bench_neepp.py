@@ -4,7 +4,8 @@
 For every scene, at each sample count (default 4, 64, 1024) every policy renders the same scene with the
 same seed; the tables give, with ratios to `nee`: relMSE against the reference, shadow rays traced,
 time inside occlusion queries (visibility-test time) and total render time. An equal-time block then
-gives each policy the wall time `nee` needed at the middle sample count and compares relMSE. For `nee`
+gives each policy the wall time `nee` needed at the middle sample count and compares relMSE, and, from
+a second render with another seed, relVar: the variance alone, free of the reference's floor. For `nee`
 the unoccluded fraction of its shadow rays (the oracle's best possible ratio) is reported too.
 
 Resolution: the reference's divided by --scale (default 4, e.g. 160x90 for classroom), rendered with a
@@ -120,9 +121,23 @@ def main(argv=None) -> int:
         # Equal time: every policy gets the wall time `nee` used at the middle sample count.
         mid = spps[len(spps) // 2]
         budget = next(r for r in results[scene]["equal_spp"][mid] if r["policy"] == "nee")["render_s"]
-        rows, _ = run_policies(policies, "equal_time", ref, lambda policy, name: render(
+        rows, equal_time_images = run_policies(policies, "equal_time", ref, lambda policy, name: render(
             xml, out / scene / name, policy, time_s=budget, w=w, h=h, max_depth=a.max_depth, seed=a.seed,
             threads=a.threads, options=options))
+        # The same again with another seed: the pair's difference measures each policy's variance without
+        # the reference's floor (at high spp relMSE against the reference is mostly that floor, which
+        # pulls every ratio toward 1).
+        base_var = None
+        for row in rows:
+            policy = row["policy"]
+            again = render(xml, out / scene / f"{policy}_equal_time_seed2.exr", policy, time_s=budget, w=w, h=h,
+                           max_depth=a.max_depth, seed=a.seed + 1000, threads=a.threads, options=options)
+            row["relVar"] = metrics.relative_variance(equal_time_images[policy], again.image, ref)
+            row["spp (seed 2)"] = again.stats["spp"]
+            base_var = base_var or row["relVar"]
+            if policy != "nee":
+                row["relVar ratio"] = row["relVar"] / base_var
+            print(json.dumps(row), flush=True)
         results[scene]["equal_time"] = {"budget_s": budget, "rows": rows}
         md.append(f"\n### equal time: {budget:.2f} s (nee's time at {mid} spp)\n\n" + table(rows) + "\n")
         (out / "results.json").write_text(json.dumps(results, indent=2))

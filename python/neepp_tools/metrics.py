@@ -31,6 +31,16 @@ def relmse(img, ref, eps: float = EPS) -> float:
     return float(np.mean((a - r) ** 2 / (r * r + eps)))
 
 
+def relative_variance(img_a, img_b, ref, eps: float = EPS) -> float:
+    """Per-pixel variance of an unbiased renderer from two independent renders (different seeds) of the same
+    scene and time or spp: E[(a - b)^2] = 2 Var, normalized like relmse by ref^2 + eps. Unlike relmse
+    against a reference it holds no floor from the reference's own noise or from systematic differences
+    between renderers (pixel filter, texture decoding), so ratios of it compare noise alone."""
+    a, r = _pair(img_a, ref)
+    b, _ = _pair(img_b, ref)
+    return float(np.mean((a - b) ** 2 / (r * r + eps)) / 2)
+
+
 def rmse(img, ref) -> float:
     a, r = _pair(img, ref)
     return float(np.sqrt(np.mean((a - r) ** 2)))

@@ -64,3 +64,17 @@ def test_relmse_stderr_matches_iid_noise():
     m = 0.01 / 1.01
     expected = m * np.sqrt(2 / 3) / 256
     assert metrics.relmse_stderr(img, ref) == pytest.approx(expected, rel=0.15)
+
+
+def test_relative_variance_matches_known_noise():
+    # Two renders = truth + independent noise of standard deviation sigma * truth: relVar -> sigma^2
+    # (normalized by ref^2 + eps, with ref = truth large enough that eps does not matter).
+    rng = np.random.default_rng(5)
+    ref = np.full((200, 200, 3), 4.0)
+    sigma = 0.1
+    a = ref * (1 + sigma * rng.standard_normal(ref.shape))
+    b = ref * (1 + sigma * rng.standard_normal(ref.shape))
+    assert metrics.relative_variance(a, b, ref) == pytest.approx(sigma**2 * 16 / (16 + metrics.EPS), rel=0.02)
+    # A common offset (bias, which relmse against the reference would count) is invisible to it.
+    assert metrics.relative_variance(a + 1, b + 1, ref) == pytest.approx(metrics.relative_variance(a, b, ref))
+    assert metrics.relative_variance(a, a, ref) == 0
