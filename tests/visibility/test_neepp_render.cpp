@@ -200,3 +200,42 @@ TEST(NeeppRender, StatisticsDescribeTheMapAndTheRoulette) {
 }
 
 }  // namespace
+
+namespace {
+
+// Renders the two rooms with neepp; of the pairs the seeding measured at least `at_least` times, returns
+// how many there are and how many the render's online learning changed.
+std::pair<int, int> seeded_pairs_changed_by_render(int learn_until, int at_least) {
+    auto scene = load_scene(two_rooms_path());
+    Options o(OptionMap{{"shadow_rays", "neepp"}, {"max_depth", "4"}, {"learn_until", std::to_string(learn_until)}});
+    auto integ = make_integrator("path", o);
+    auto &tester = dynamic_cast<NeeppShadowRays &>(dynamic_cast<PathIntegrator &>(*integ).shadow_rays());
+    NeeppShadowRays seeded(tester.options());  // the same seeding, kept to compare with
+    seeded.prepare(*scene);
+    RenderJob job;
+    job.spp = 16;
+    render(*scene, *integ, job);
+    int measured = 0, changed = 0;
+    for (uint64_t p = 0; p < seeded.map().pair_count(); ++p) {
+        const PairCounts before = seeded.map().counts_at(p), after = tester.map().counts_at(p);
+        if (before.traced == 0 || before.traced < at_least) continue;
+        ++measured;
+        changed += after.traced != before.traced || after.visible != before.visible;
+    }
+    return {measured, changed};
+}
+
+}  // namespace
+
+// Pairs whose count has reached learn_until are no longer updated; below it, rendering keeps learning.
+TEST(NeeppRender, LearningStopsAtLearnUntil) {
+    const int per_pair = NeeppOptions{}.samples_per_pair;
+    auto [measured, changed] = seeded_pairs_changed_by_render(NeeppOptions{}.learn_until, per_pair);
+    EXPECT_GT(measured, 1000);
+    EXPECT_GT(changed, measured / 50) << "below the cap, the render's shadow rays update the map";
+    auto [measured_at_cap, changed_at_cap] = seeded_pairs_changed_by_render(per_pair, per_pair);
+    EXPECT_EQ(measured_at_cap, measured);
+    EXPECT_EQ(changed_at_cap, 0) << "pairs seeded up to the cap may not change";
+    EXPECT_THROW(make_integrator("path", Options(OptionMap{{"shadow_rays", "neepp"}, {"learn_until", "0"}})),
+                 std::invalid_argument);
+}

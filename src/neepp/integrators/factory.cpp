@@ -34,6 +34,8 @@ std::unique_ptr<Integrator> make_integrator(const std::string &name, const Optio
             n.q_min = options.get_float("q_min", n.q_min);
             n.map_file = options.get_string("visibility_map", n.map_file);
             n.learn = options.get_bool("learn", n.learn);
+            n.learn_until = options.get_int("learn_until", n.learn_until);
+            if (n.learn_until < 1) throw std::invalid_argument("learn_until must be at least 1");
             if (n.policy == ShadowRayPolicy::NeeppAdaptive) {
                 n.adaptive_target = options.get_string("adaptive_target", n.adaptive_target);
                 n.shadow_ray_cost = options.get_float("shadow_ray_cost", n.shadow_ray_cost);

@@ -149,12 +149,12 @@ bool PathIntegrator::begin_direct(Path &path) const {
     if (is_black(f)) return false;
     float light_pdf = ds.pdf * sl.pmf;
     float w = ds.delta ? 1.f : mis_power(light_pdf, bsdf.pdf(bctx, si, si.wi, wo));
-    ShadowQuery &q = path.shadow;
+    ShadowQuery &q = path.shadow = ShadowQuery{};  // nothing the policy kept from the last bounce
     q.ray = ds.dist >= kInfinity ? si.spawn_ray(ds.d) : si.spawn_ray_to(ds.p);
     q.from = si.p;
     q.to = ds.p;
     q.unoccluded = path.beta * f * Le * (w / light_pdf);
-    shadow_->prefetch(q);
+    shadow_->prepare(q);
     return true;
 }
 

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <filesystem>
 #include <stdexcept>
+#include <tuple>
 #include "neepp/sampling/sampler.h"
 #include "neepp/scene/scene.h"
 #include "neepp/visibility/map_file.h"
@@ -53,15 +54,14 @@ float NeeppShadowRays::trace_probability(PairCounts c, bool same_cell, float lum
 
 // Shadow rays toward environment lights are spawned with an infinite tmax; they are keyed by direction.
 std::pair<uint32_t, uint32_t> NeeppShadowRays::cells_of(const ShadowQuery &q) const {
+    if (q.from_cell != ShadowQuery::kUnknownCell) return {q.from_cell, q.to_cell};
     const bool to_infinity = q.ray.tmax >= kInfinity;
     return {grid_.voxel_of(q.from), to_infinity ? grid_.cell_of_direction(q.ray.d) : grid_.voxel_of(q.to)};
 }
 
-void NeeppShadowRays::prefetch(const ShadowQuery &q) const {
-    const auto [a, b] = cells_of(q);
-    const uint64_t pair = VisibilityMap::pair_index(a, b);
-    if (options_.policy != ShadowRayPolicy::TraceAll) map_.prefetch(pair);
-    if (options_.learn) threads_.local().updates.prefetch(pair);
+void NeeppShadowRays::prepare(ShadowQuery &q) const {
+    std::tie(q.from_cell, q.to_cell) = cells_of(q);
+    if (options_.policy != ShadowRayPolicy::TraceAll) map_.prefetch(VisibilityMap::pair_index(q.from_cell, q.to_cell));
 }
 
 ShadowTest NeeppShadowRays::begin_test(const ShadowQuery &q, Sampler &sampler, RenderCounters &counters) const {
@@ -73,6 +73,7 @@ ShadowTest NeeppShadowRays::begin_test(const ShadowQuery &q, Sampler &sampler, R
     if (options_.learn) test.learn_pair = pair;
     if (options_.policy == ShadowRayPolicy::TraceAll) return test;  // learns, never reads the map
     const PairCounts c = map_.counts_at(pair);
+    if (c.traced >= options_.learn_until) test.learn_pair = ~uint64_t(0);
     if (a == b || c.traced == 0) {
         ++(a == b ? ts.forced_same_cell : ts.forced_unknown);
         return test;
@@ -218,6 +219,7 @@ nlohmann::json NeeppShadowRays::describe() const {
                         {"samples_per_pair", options_.samples_per_pair},
                         {"q_min", options_.q_min},
                         {"learn", options_.learn},
+                        {"learn_until", options_.learn_until},
                         {"visibility_map", options_.map_file}};
     if (options_.policy == ShadowRayPolicy::NeeppAdaptive) {
         j["adaptive_target"] = options_.adaptive_target;

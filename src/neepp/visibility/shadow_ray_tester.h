@@ -21,6 +21,10 @@ struct ShadowQuery {
     Ray ray;
     Vec3 from, to;
     Color unoccluded;  // contribution if visible (throughput × f × Le / pdf, MIS included)
+    // Where a policy keeps what it worked out about the query in prepare() (NEE++: the voxel of each end
+    // point), so begin_test need not work it out again.
+    static constexpr uint32_t kUnknownCell = ~0u;
+    uint32_t from_cell = kUnknownCell, to_cell = kUnknownCell;
 };
 
 // A policy's decision on one query, taken before any ray is traced: whether to trace, and the weight of
@@ -46,9 +50,10 @@ public:
     float visibility(const Scene &scene, const ShadowQuery &q, Sampler &sampler, RenderCounters &counters) const;
     virtual ShadowTest begin_test(const ShadowQuery &q, Sampler &sampler, RenderCounters &counters) const = 0;
     virtual void end_test(const ShadowTest &test, bool occluded) const {}
-    // Cache prefetch of what begin_test(q) and end_test will read and write (NEE++: the pair's map entry
-    // and update slot), for integrators that form many queries before deciding any. A hint only.
-    virtual void prefetch(const ShadowQuery &q) const {}
+    // For integrators that form many queries before deciding any: locates q (NEE++: its voxel pair, kept
+    // in q) and prefetches what begin_test(q) will read (the pair's map entry). Optional: begin_test
+    // gives the same answer without it.
+    virtual void prepare(ShadowQuery &q) const {}
     virtual std::string policy() const = 0;
     // Hooks of the render loop, both single-threaded: prepare() before the first pass (build or load the
     // visibility map), end_pass() after each pass (merge what the pass learned; the next pass reads the
