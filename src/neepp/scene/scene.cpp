@@ -12,6 +12,26 @@ void embree_error(void *, RTCError code, const char *message) {
     std::fprintf(stderr, "Embree error %d: %s\n", int(code), message ? message : "");
 }
 
+// Embree's ray for ours: no motion time, every mask bit, no flags.
+void to_embree(const Ray &ray, RTCRay &r) {
+    r.org_x = ray.o.x; r.org_y = ray.o.y; r.org_z = ray.o.z;
+    r.dir_x = ray.d.x; r.dir_y = ray.d.y; r.dir_z = ray.d.z;
+    r.tnear = ray.tmin; r.tfar = ray.tmax;
+    r.time = 0; r.mask = 0xFFFFFFFFu; r.id = 0; r.flags = 0;
+}
+
+// A packet of rays[0..n); the lanes beyond n repeat ray 0 and are marked invalid.
+void to_embree16(const Ray *const *rays, int n, RTCRay16 &r, int *valid) {
+    for (int i = 0; i < 16; ++i) {
+        valid[i] = i < n ? -1 : 0;
+        const Ray &ray = *rays[i < n ? i : 0];
+        r.org_x[i] = ray.o.x; r.org_y[i] = ray.o.y; r.org_z[i] = ray.o.z;
+        r.dir_x[i] = ray.d.x; r.dir_y[i] = ray.d.y; r.dir_z[i] = ray.d.z;
+        r.tnear[i] = ray.tmin; r.tfar[i] = ray.tmax;
+        r.time[i] = 0; r.mask[i] = 0xFFFFFFFFu; r.id[i] = 0; r.flags[i] = 0;
+    }
+}
+
 }  // namespace
 
 Scene::Scene() {
@@ -91,10 +111,7 @@ RayHit Scene::trace(const Ray &ray) const {
     RTCIntersectContext ctx;
     rtcInitIntersectContext(&ctx);
     RTCRayHit rh;
-    rh.ray.org_x = ray.o.x; rh.ray.org_y = ray.o.y; rh.ray.org_z = ray.o.z;
-    rh.ray.dir_x = ray.d.x; rh.ray.dir_y = ray.d.y; rh.ray.dir_z = ray.d.z;
-    rh.ray.tnear = ray.tmin; rh.ray.tfar = ray.tmax;
-    rh.ray.time = 0; rh.ray.mask = 0xFFFFFFFFu; rh.ray.id = 0; rh.ray.flags = 0;
+    to_embree(ray, rh.ray);
     rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
     rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
     rtcIntersect1(rtc_scene_, &ctx, &rh);
@@ -110,13 +127,8 @@ void Scene::trace16(const Ray *const *rays, RayHit *const *hits, int n) const {
     rtcInitIntersectContext(&ctx);
     alignas(64) int valid[16];
     alignas(64) RTCRayHit16 rh;
+    to_embree16(rays, n, rh.ray, valid);
     for (int i = 0; i < 16; ++i) {
-        valid[i] = i < n ? -1 : 0;
-        const Ray &ray = *rays[i < n ? i : 0];
-        rh.ray.org_x[i] = ray.o.x; rh.ray.org_y[i] = ray.o.y; rh.ray.org_z[i] = ray.o.z;
-        rh.ray.dir_x[i] = ray.d.x; rh.ray.dir_y[i] = ray.d.y; rh.ray.dir_z[i] = ray.d.z;
-        rh.ray.tnear[i] = ray.tmin; rh.ray.tfar[i] = ray.tmax;
-        rh.ray.time[i] = 0; rh.ray.mask[i] = 0xFFFFFFFFu; rh.ray.id[i] = 0; rh.ray.flags[i] = 0;
         rh.hit.geomID[i] = RTC_INVALID_GEOMETRY_ID;
         rh.hit.instID[0][i] = RTC_INVALID_GEOMETRY_ID;
     }
@@ -154,14 +166,7 @@ void Scene::occluded16(const Ray *const *rays, int n, bool *occluded) const {
     rtcInitIntersectContext(&ctx);
     alignas(64) int valid[16];
     alignas(64) RTCRay16 r;
-    for (int i = 0; i < 16; ++i) {
-        valid[i] = i < n ? -1 : 0;
-        const Ray &ray = *rays[i < n ? i : 0];
-        r.org_x[i] = ray.o.x; r.org_y[i] = ray.o.y; r.org_z[i] = ray.o.z;
-        r.dir_x[i] = ray.d.x; r.dir_y[i] = ray.d.y; r.dir_z[i] = ray.d.z;
-        r.tnear[i] = ray.tmin; r.tfar[i] = ray.tmax;
-        r.time[i] = 0; r.mask[i] = 0xFFFFFFFFu; r.id[i] = 0; r.flags[i] = 0;
-    }
+    to_embree16(rays, n, r, valid);
     rtcOccluded16(valid, rtc_scene_, &ctx, &r);
     for (int i = 0; i < n; ++i) occluded[i] = r.tfar[i] < 0;  // Embree sets tfar to -inf on a hit
 }
@@ -170,10 +175,7 @@ bool Scene::occluded(const Ray &ray) const {
     RTCIntersectContext ctx;
     rtcInitIntersectContext(&ctx);
     RTCRay r;
-    r.org_x = ray.o.x; r.org_y = ray.o.y; r.org_z = ray.o.z;
-    r.dir_x = ray.d.x; r.dir_y = ray.d.y; r.dir_z = ray.d.z;
-    r.tnear = ray.tmin; r.tfar = ray.tmax;
-    r.time = 0; r.mask = 0xFFFFFFFFu; r.id = 0; r.flags = 0;
+    to_embree(ray, r);
     rtcOccluded1(rtc_scene_, &ctx, &r);
     return r.tfar < 0;  // Embree sets tfar to -inf on a hit
 }
