@@ -175,7 +175,9 @@ TEST(LightSelection, VisibilitySamplerFavoursTheLightsTheMapSeesAndFollowsTheMap
     // sampler reads it; the light keeps at least the defensive share.
     VisibilityMap map = *f.map_owner->visibility_map();
     const VoxelGrid &grid = *f.map_owner->voxel_grid();
-    VisibilityLightSampler sampler(lights, grid, map, f.scene->bounds().center(), VisibilitySelectionOptions{"power"});
+    VisibilitySelectionOptions options;
+    options.base = "power";
+    VisibilityLightSampler sampler(lights, grid, map, f.scene->bounds().center(), options);
     const float before = sampler.pmf(ctx, *lights[0]);
     EXPECT_NEAR(before, p_vis, 1e-6f);
     const uint32_t a = grid.voxel_of(ctx.p);

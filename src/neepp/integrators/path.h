@@ -44,7 +44,8 @@ private:
     bool begin_vertex(const Scene &scene, Path &path) const;
     void prefetch_light(const Path &path) const;
     // Next event estimation at the vertex: begin_direct samples the light chosen at begin_vertex and forms
-    // the shadow query (false: the sample contributes nothing); decide_direct asks the shadow-ray policy
+    // the shadow query, its contribution MIS-weighted against BSDF sampling and multiplied by the path
+    // throughput so contribution-aware policies see all of it (false: it contributes nothing); decide_direct asks the shadow-ray policy
     // and returns true when a ray must be traced, whose outcome end_direct takes.
     bool begin_direct(Path &path) const;
     bool decide_direct(Path &path, RenderCounters &counters) const;
@@ -52,9 +53,6 @@ private:
     // BSDF sampling and Russian roulette: the next ray, or false when the path ends.
     bool finish_vertex(Path &path) const;
 
-    // Radiance from light sources by light sampling at si, MIS-weighted against BSDF sampling and
-    // multiplied by the path throughput beta (so contribution-aware shadow-ray policies see the sample's
-    // full contribution).
     // MIS weight for emission found by a BSDF-sampled ray leaving prev (pdf prev_pdf) toward light.
     float emission_weight(const Light &light, const LightSampleContext &prev, const DirectionSample &ds,
                           float prev_pdf) const;

@@ -12,22 +12,21 @@ EnvironmentMapLight::EnvironmentMapLight(Image image, const Transform &to_world,
     width_ = image.width, height_ = image.height;
     if (image.width < 2 || image.height < 2) throw std::runtime_error("envmap: image too small");
     const int w = width_, h = height_;
-    const size_t n = size_t(w) * h;
+    std::vector<float> rgb(3 * size_t(w) * h);
     float largest = 0;
-    for (size_t i = 0; i < n; ++i)
-        for (int c = 0; c < 3; ++c) largest = std::max(largest, std::abs(image.rgb(int(i % w), int(i / w))[c]));
+    for (int y = 0; y < h; ++y)
+        for (int x = 0; x < w; ++x) {
+            const Color c = image.rgb(x, y);
+            for (int k = 0; k < 3; ++k) {
+                rgb[3 * (size_t(y) * w + x) + k] = c[k];
+                largest = std::max(largest, std::abs(c[k]));
+            }
+        }
     if (std::isfinite(largest) && largest <= float(HALF_MAX)) {
-        half_.resize(3 * n);
-        for (size_t i = 0; i < n; ++i) {
-            Color c = image.rgb(int(i % w), int(i / w));
-            for (int k = 0; k < 3; ++k) half_[3 * i + k] = imath_float_to_half(c[k]);
-        }
+        half_.resize(rgb.size());
+        for (size_t i = 0; i < rgb.size(); ++i) half_[i] = imath_float_to_half(rgb[i]);
     } else {
-        float_.resize(3 * n);
-        for (size_t i = 0; i < n; ++i) {
-            Color c = image.rgb(int(i % w), int(i / w));
-            for (int k = 0; k < 3; ++k) float_[3 * i + k] = c[k];
-        }
+        float_ = std::move(rgb);
     }
     image = Image();  // the texels above are all that is kept
     // Sampling density ∝ luminance × sin(theta) of the row (the equirectangular area element), so the
@@ -94,8 +93,6 @@ Vec3 EnvironmentMapLight::uv_to_direction(Vec2 uv) const {
     return normalize(to_world_.vector(local));
 }
 
-// Bilinear lookup with Mitsuba's envmap convention: texel (i, j) sits at u = i / W (the map wraps
-// horizontally) and v = j / (H - 1) (the first and last rows lie on the poles).
 Color EnvironmentMapLight::texel(int x, int y) const {
     const size_t i = 3 * (size_t(y) * width_ + x);
     if (!half_.empty()) return Color(imath_half_to_float(half_[i]), imath_half_to_float(half_[i + 1]),
@@ -103,6 +100,8 @@ Color EnvironmentMapLight::texel(int x, int y) const {
     return Color(float_[i], float_[i + 1], float_[i + 2]);
 }
 
+// Bilinear lookup with Mitsuba's envmap convention: texel (i, j) sits at u = i / W (the map wraps
+// horizontally) and v = j / (H - 1) (the first and last rows lie on the poles).
 Color EnvironmentMapLight::lookup(Vec2 uv) const {
     const int w = width_, h = height_;
     float x = uv.x * float(w), y = uv.y * float(h - 1);

@@ -25,12 +25,12 @@ public:
     // Samples a direction toward the light from ref. Returns the emitted radiance arriving at ref along
     // -d, ignoring occlusion, via `radiance` (zero when the sample is invalid, e.g. the back of an area light).
     virtual DirectionSample sample_direction(const Vec3 &ref, Vec2 u, Color &radiance) const = 0;
-    // Solid-angle density with which sample_direction would have produced ds from ref (0 for delta lights).
     // Cache prefetch of what sample_direction(ref, u) will read, in dependency order: level 0 what u
     // alone locates, level 1 what level 0 brought in locates. A hint for batched integrators, which
     // issue it for many paths before sampling any (a light sample is otherwise a chain of cache misses);
     // it never changes a result.
     virtual void prefetch_sample(Vec2 u, int level) const {}
+    // Solid-angle density with which sample_direction would have produced ds from ref (0 for delta lights).
     virtual float pdf_direction(const Vec3 &ref, const DirectionSample &ds) const = 0;
     // Radiance leaving a point of an area light toward direction w (world, pointing away from the light).
     virtual Color eval_surface(const SurfaceInteraction &si, const Vec3 &w) const { return Color(0.f); }

@@ -73,7 +73,7 @@ ShadowTest NeeppShadowRays::begin_test(const ShadowQuery &q, Sampler &sampler, R
     if (options_.learn) test.learn_pair = pair;
     if (options_.policy == ShadowRayPolicy::TraceAll) return test;  // learns, never reads the map
     const PairCounts c = map_.counts_at(pair);
-    if (c.traced >= options_.learn_until) test.learn_pair = ~uint64_t(0);
+    if (c.traced >= options_.learn_until) test.learn_pair = ShadowTest::kNoPair;
     if (a == b || c.traced == 0) {
         ++(a == b ? ts.forced_same_cell : ts.forced_unknown);
         return test;
@@ -114,7 +114,7 @@ ShadowTest NeeppShadowRays::begin_test(const ShadowQuery &q, Sampler &sampler, R
 }
 
 void NeeppShadowRays::end_test(const ShadowTest &test, bool occluded) const {
-    if (test.learn_pair != ~uint64_t(0)) threads_.local().updates.record(test.learn_pair, !occluded);
+    if (test.learn_pair != ShadowTest::kNoPair) threads_.local().updates.record(test.learn_pair, !occluded);
 }
 
 void NeeppShadowRays::adopt_map(const VoxelGrid &grid, VisibilityMap map) {

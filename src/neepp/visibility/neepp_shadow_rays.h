@@ -62,8 +62,8 @@ struct NeeppOptions {
     // ... until a pair's count reaches this: its Ṽ is then known to ±3 % (binomial standard error at most
     // 0.5/sqrt(n)), enough for choosing q, and each further update would be a hash-table write per shadow
     // ray (3 % of cornell-box's render time) that changes little. A map seeded wrong (16 samples) still
-    // learns 240 outcomes per pair before it stops. Read from the frozen map, so renders
-    // stay reproducible; applies where the policy reads the pair's counts anyway (roulette policies).
+    // learns 240 outcomes per pair before it stops. Read from the frozen map, so renders stay
+    // reproducible; applies where the policy reads the pair's counts anyway (roulette policies).
     int learn_until = 256;
 };
 

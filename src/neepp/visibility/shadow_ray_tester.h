@@ -33,7 +33,8 @@ struct ShadowTest {
     bool trace = true;
     float if_visible = 1.f, if_occluded = 0.f;  // weights when traced
     float if_skipped = 0.f;                     // weight when not traced
-    uint64_t learn_pair = ~uint64_t(0);         // NEE++: the map pair the traced ray's outcome updates
+    static constexpr uint64_t kNoPair = ~uint64_t(0);
+    uint64_t learn_pair = kNoPair;              // NEE++: the map pair the traced ray's outcome updates
     float weight(bool occluded) const { return trace ? (occluded ? if_occluded : if_visible) : if_skipped; }
 };
 

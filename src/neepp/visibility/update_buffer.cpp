@@ -2,6 +2,13 @@
 
 namespace neepp {
 
+namespace {
+inline uint32_t slot_hash(uint32_t key) {
+    key ^= key >> 16; key *= 0x7feb352dU; key ^= key >> 15; key *= 0x846ca68bU; key ^= key >> 16;
+    return key;
+}
+}  // namespace
+
 void PairUpdateBuffer::add(uint64_t pair, uint32_t visible, uint32_t traced) {
     if (2 * (size_ + 1) > slots_.size()) grow();  // load factor <= 1/2
     const uint32_t key = uint32_t(pair) + 1, mask = uint32_t(slots_.size() - 1);

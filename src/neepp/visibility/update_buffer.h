@@ -17,10 +17,6 @@ public:
     };
 
     void record(uint64_t pair, bool visible) { add(pair, visible ? 1u : 0u, 1u); }
-    // Cache prefetch of the slot record(pair) probes first (a hint for batched callers).
-    void prefetch(uint64_t pair) const {
-        if (!slots_.empty()) __builtin_prefetch(&slots_[slot_hash(uint32_t(pair) + 1) & (slots_.size() - 1)]);
-    }
     // Adds already-summed outcomes (merging other buffers).
     void add(uint64_t pair, uint32_t visible, uint32_t traced);
     template <typename F> void for_each(F &&f) const {
@@ -31,10 +27,6 @@ public:
     void clear();
 
 private:
-    static uint32_t slot_hash(uint32_t key) {
-        key ^= key >> 16; key *= 0x7feb352dU; key ^= key >> 15; key *= 0x846ca68bU; key ^= key >> 16;
-        return key;
-    }
     void grow();
     std::vector<Entry> slots_;
     size_t size_ = 0;
