@@ -4,7 +4,7 @@
 # Extra packages may be passed as arguments (e.g. `install_deps.sh libllvm19`).
 set -euo pipefail
 
-PKGS=(cmake ninja-build g++ pkg-config libembree-dev libtbb-dev libopenexr-dev libpugixml-dev
+PKGS=(cmake ninja-build g++ pkg-config libembree-dev libtbb-dev libopenexr-dev libimath-dev libpugixml-dev
       libjpeg-dev libcli11-dev libfmt-dev libstb-dev nlohmann-json3-dev libgtest-dev
       python3-venv "$@")
 
