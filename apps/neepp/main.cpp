@@ -196,7 +196,7 @@ int main(int argc, char **argv) {
     render->add_option("-I", ra.integrator_options,
                        "Integrator option key=value; path: max_depth, rr_depth, hide_emitters, nee, light_sampler (" +
                            samplers + "), shadow_rays (nee, neepp, neepp-adaptive, neepp-cv), voxels, samples_per_pair, "
-                           "q_min, learn, learn_until, adaptive_target, shadow_ray_cost (see README)");
+                           "q_min, learn, learn_until, min_occluded, adaptive_target, shadow_ray_cost (see README)");
     render->add_option("--sampler", ra.sampler, "Sampler: independent or sobol (default: the scene's)");
     render->add_option("--rfilter", ra.rfilter, "Override the film's reconstruction filter")
         ->check(CLI::IsMember({"box", "tent", "gaussian"}));

@@ -106,12 +106,14 @@ TEST_P(PolicyTest, StaysUnbiasedWhenTheMapClaimsEverythingOccluded) {
     const Moments &nee = nee_reference("rooms", two_rooms_path(), 64);
     Moments pol = block_moments(two_rooms_path(), GetParam(), kSeeds, 64, 7001, MapSetup::ClaimsOccluded);
     expect_same_image(nee, pol, GetParam() + " map claims occluded");
+    EXPECT_GT(pol.skipped, 0u);
 }
 
 TEST_P(PolicyTest, StaysUnbiasedWithAMapSeededBehindAClosedDoor) {
     const Moments &nee = nee_reference("rooms", two_rooms_path(), 64);
     Moments pol = block_moments(two_rooms_path(), GetParam(), kSeeds, 64, 9001, MapSetup::FromClosedDoor);
     expect_same_image(nee, pol, GetParam() + " map from closed door");
+    EXPECT_GT(pol.skipped, 0u);
 }
 
 TEST_P(PolicyTest, AgreesWithNeeForAnEnvironmentThroughAWindow) {
@@ -237,5 +239,44 @@ TEST(NeeppRender, LearningStopsAtLearnUntil) {
     EXPECT_EQ(measured_at_cap, measured);
     EXPECT_EQ(changed_at_cap, 0) << "pairs seeded up to the cap may not change";
     EXPECT_THROW(make_integrator("path", Options(OptionMap{{"shadow_rays", "neepp"}, {"learn_until", "0"}})),
+                 std::invalid_argument);
+}
+
+namespace {
+
+struct GuardedRun {
+    RenderCounters counters;
+    nlohmann::json rejection;
+};
+
+GuardedRun render_two_rooms_guarded(const std::string &min_occluded, int spp) {
+    auto scene = load_scene(two_rooms_path());
+    auto integ = make_integrator("path", Options(OptionMap{{"shadow_rays", "neepp"}, {"max_depth", "4"},
+                                                           {"min_occluded", min_occluded}}));
+    RenderJob job;
+    job.spp = spp;
+    RenderResult r = render(*scene, *integ, job);
+    return {r.counters, integ->statistics()["shadow_rays"]["rejection"]};
+}
+
+}  // namespace
+
+// The first pass traces every shadow ray; rejection then stays on only if enough of them were occluded.
+TEST(NeeppRender, RejectionNeedsEnoughOccludedShadowRays) {
+    GuardedRun first = render_two_rooms_guarded("0", 1);
+    EXPECT_EQ(first.counters.shadow_rays_skipped, 0u) << "the first pass traces every ray";
+    const double fraction = first.rejection["first_pass_occluded_fraction"].get<double>();
+    ASSERT_GT(fraction, 0.3) << "two rooms behind a door: most shadow rays are blocked";
+    ASSERT_LT(fraction, 0.99);
+    EXPECT_EQ(first.rejection["first_pass_shadow_rays"].get<uint64_t>(), first.counters.shadow_rays);
+
+    GuardedRun on = render_two_rooms_guarded(std::to_string(fraction - 0.01), 8);
+    EXPECT_EQ(on.rejection["state"], "on");
+    EXPECT_GT(on.counters.shadow_rays_skipped, 0u);
+    GuardedRun off = render_two_rooms_guarded(std::to_string(fraction + 0.01), 8);
+    EXPECT_EQ(off.rejection["state"], "off");
+    EXPECT_EQ(off.counters.shadow_rays_skipped, 0u);
+    EXPECT_DOUBLE_EQ(off.rejection["first_pass_occluded_fraction"].get<double>(), fraction) << "same first pass";
+    EXPECT_THROW(make_integrator("path", Options(OptionMap{{"shadow_rays", "neepp"}, {"min_occluded", "1.5"}})),
                  std::invalid_argument);
 }

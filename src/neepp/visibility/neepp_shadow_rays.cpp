@@ -61,7 +61,8 @@ std::pair<uint32_t, uint32_t> NeeppShadowRays::cells_of(const ShadowQuery &q) co
 
 void NeeppShadowRays::prepare(ShadowQuery &q) const {
     std::tie(q.from_cell, q.to_cell) = cells_of(q);
-    if (options_.policy != ShadowRayPolicy::TraceAll) map_.prefetch(VisibilityMap::pair_index(q.from_cell, q.to_cell));
+    if (options_.policy != ShadowRayPolicy::TraceAll && phase_ == Phase::Rejecting)
+        map_.prefetch(VisibilityMap::pair_index(q.from_cell, q.to_cell));
 }
 
 ShadowTest NeeppShadowRays::begin_test(const ShadowQuery &q, Sampler &sampler, RenderCounters &counters) const {
@@ -70,10 +71,12 @@ ShadowTest NeeppShadowRays::begin_test(const ShadowQuery &q, Sampler &sampler, R
     ThreadState &ts = threads_.local();
 
     ShadowTest test;  // traced, weight V
+    if (phase_ == Phase::Off) return test;  // plain NEE from here on: no lookup, no learning
     if (options_.learn) test.learn_pair = pair;
     if (options_.policy == ShadowRayPolicy::TraceAll) return test;  // learns, never reads the map
     const PairCounts c = map_.counts_at(pair);
     if (c.traced >= options_.learn_until) test.learn_pair = ShadowTest::kNoPair;
+    if (phase_ == Phase::Probe) return test;  // the first pass traces every query
     if (a == b || c.traced == 0) {
         ++(a == b ? ts.forced_same_cell : ts.forced_unknown);
         return test;
@@ -114,7 +117,13 @@ ShadowTest NeeppShadowRays::begin_test(const ShadowQuery &q, Sampler &sampler, R
 }
 
 void NeeppShadowRays::end_test(const ShadowTest &test, bool occluded) const {
-    if (test.learn_pair != ShadowTest::kNoPair) threads_.local().updates.record(test.learn_pair, !occluded);
+    if (phase_ == Phase::Off) return;
+    ThreadState &ts = threads_.local();
+    if (test.learn_pair != ShadowTest::kNoPair) ts.updates.record(test.learn_pair, !occluded);
+    if (phase_ == Phase::Probe) {
+        ++ts.probe_traced;
+        ts.probe_occluded += occluded;
+    }
 }
 
 void NeeppShadowRays::adopt_map(const VoxelGrid &grid, VisibilityMap map) {
@@ -129,6 +138,7 @@ void NeeppShadowRays::prepare(const Scene &scene) {
     threads_.clear();
     totals_ = Totals{};
     adaptive_scale_ = 0;
+    phase_ = Phase::Probe;
     if (adopted_) return;
     seeding_ = SeedingStats{};
     load_time_s_ = 0;
@@ -199,11 +209,16 @@ void NeeppShadowRays::end_pass(const PassStatistics &pass) {
         }
         ts.roulettes = ts.roulette_traced = ts.skipped = ts.forced_unknown = ts.forced_same_cell = 0;
         ts.q_sum_fixed = ts.paper_q_sum_fixed = 0;
+        totals_.probe_traced += ts.probe_traced;
+        totals_.probe_occluded += ts.probe_occluded;
+        ts.probe_traced = ts.probe_occluded = 0;
     }
     merged.for_each([&](uint64_t pair, uint32_t v, uint32_t t) {
         map_.add(pair, v, t);
         totals_.updates_merged += t;
     });
+    if (phase_ == Phase::Probe && options_.policy != ShadowRayPolicy::TraceAll)
+        phase_ = occluded_fraction() >= double(options_.min_occluded) ? Phase::Rejecting : Phase::Off;
     if (options_.policy == ShadowRayPolicy::NeeppAdaptive) {
         if (options_.adaptive_target == "rays") calibrate_adaptive(histogram, roulettes, paper_q);
         else if (pass.sample_variance > 0)
@@ -220,6 +235,7 @@ nlohmann::json NeeppShadowRays::describe() const {
                         {"q_min", options_.q_min},
                         {"learn", options_.learn},
                         {"learn_until", options_.learn_until},
+                        {"min_occluded", options_.min_occluded},
                         {"visibility_map", options_.map_file}};
     if (options_.policy == ShadowRayPolicy::NeeppAdaptive) {
         j["adaptive_target"] = options_.adaptive_target;
@@ -259,6 +275,11 @@ nlohmann::json NeeppShadowRays::statistics() const {
         {"merge_time_s", totals_.merge_time_s},
     };
     nlohmann::json j = {{"policy", policy()}, {"map", map}, {"roulette", roulette}};
+    if (options_.policy != ShadowRayPolicy::TraceAll)
+        j["rejection"] = {{"first_pass_shadow_rays", totals_.probe_traced},
+                          {"first_pass_occluded_fraction", occluded_fraction()},
+                          {"min_occluded", options_.min_occluded},
+                          {"state", phase_ == Phase::Probe ? "first pass" : phase_ == Phase::Rejecting ? "on" : "off"}};
     if (options_.policy == ShadowRayPolicy::NeeppAdaptive) j["adaptive_scale"] = adaptive_scale_;
     return j;
 }
