@@ -60,18 +60,18 @@ std::pair<uint32_t, uint32_t> NeeppShadowRays::cells_of(const ShadowQuery &q) co
 }
 
 void NeeppShadowRays::prepare(ShadowQuery &q) const {
+    if (phase_ == Phase::Off) return;  // begin_test will not look
     std::tie(q.from_cell, q.to_cell) = cells_of(q);
     if (options_.policy != ShadowRayPolicy::TraceAll && phase_ == Phase::Rejecting)
         map_.prefetch(VisibilityMap::pair_index(q.from_cell, q.to_cell));
 }
 
 ShadowTest NeeppShadowRays::begin_test(const ShadowQuery &q, Sampler &sampler, RenderCounters &counters) const {
+    ShadowTest test;  // traced, weight V
+    if (phase_ == Phase::Off) return test;  // plain NEE from here on: no lookup, no learning
     const auto [a, b] = cells_of(q);
     const uint64_t pair = VisibilityMap::pair_index(a, b);
     ThreadState &ts = threads_.local();
-
-    ShadowTest test;  // traced, weight V
-    if (phase_ == Phase::Off) return test;  // plain NEE from here on: no lookup, no learning
     if (options_.learn) test.learn_pair = pair;
     if (options_.policy == ShadowRayPolicy::TraceAll) return test;  // learns, never reads the map
     const PairCounts c = map_.counts_at(pair);
