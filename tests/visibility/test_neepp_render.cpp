@@ -43,7 +43,9 @@ PolicyRun render_policy(const std::string &xml_path, const std::string &policy, 
         } else {
             // Seeded with the door closed, rendered with it open: the door pairs were seen fully occluded.
             auto closed = load_scene(write_temp_scene(two_rooms_xml(true)));
-            NeeppShadowRays seeder(tester->options());
+            NeeppOptions seeding = tester->options();
+            seeding.defer_seeding = false;  // seeded by prepare(), not after a first pass
+            NeeppShadowRays seeder(seeding);
             seeder.prepare(*closed);
             tester->adopt_map(seeder.grid(), seeder.map());
         }
@@ -212,7 +214,9 @@ std::pair<int, int> seeded_pairs_changed_by_render(int learn_until, int at_least
     Options o(OptionMap{{"shadow_rays", "neepp"}, {"max_depth", "4"}, {"learn_until", std::to_string(learn_until)}});
     auto integ = make_integrator("path", o);
     auto &tester = dynamic_cast<NeeppShadowRays &>(dynamic_cast<PathIntegrator &>(*integ).shadow_rays());
-    NeeppShadowRays seeded(tester.options());  // the same seeding, kept to compare with
+    NeeppOptions seeding = tester.options();
+    seeding.defer_seeding = false;
+    NeeppShadowRays seeded(seeding);  // the same seeding (deferred in the render), kept to compare with
     seeded.prepare(*scene);
     RenderJob job;
     job.spp = 16;
@@ -246,7 +250,7 @@ namespace {
 
 struct GuardedRun {
     RenderCounters counters;
-    nlohmann::json rejection;
+    nlohmann::json rejection, map;
 };
 
 GuardedRun render_two_rooms_guarded(const std::string &min_occluded, int spp) {
@@ -256,7 +260,8 @@ GuardedRun render_two_rooms_guarded(const std::string &min_occluded, int spp) {
     RenderJob job;
     job.spp = spp;
     RenderResult r = render(*scene, *integ, job);
-    return {r.counters, integ->statistics()["shadow_rays"]["rejection"]};
+    const nlohmann::json stats = integ->statistics()["shadow_rays"];
+    return {r.counters, stats["rejection"], stats["map"]};
 }
 
 }  // namespace
@@ -273,9 +278,13 @@ TEST(NeeppRender, RejectionNeedsEnoughOccludedShadowRays) {
     GuardedRun on = render_two_rooms_guarded(std::to_string(fraction - 0.01), 8);
     EXPECT_EQ(on.rejection["state"], "on");
     EXPECT_GT(on.counters.shadow_rays_skipped, 0u);
+    EXPECT_EQ(on.map["source"], "built") << "seeded after the first pass";
+    EXPECT_GT(on.map["build_shadow_rays"].get<uint64_t>(), 0u);
     GuardedRun off = render_two_rooms_guarded(std::to_string(fraction + 0.01), 8);
     EXPECT_EQ(off.rejection["state"], "off");
     EXPECT_EQ(off.counters.shadow_rays_skipped, 0u);
+    EXPECT_EQ(off.map["source"], "not built") << "no map is seeded for a render that will not use it";
+    EXPECT_EQ(off.map["build_shadow_rays"].get<uint64_t>(), 0u);
     EXPECT_DOUBLE_EQ(off.rejection["first_pass_occluded_fraction"].get<double>(), fraction) << "same first pass";
     EXPECT_THROW(make_integrator("path", Options(OptionMap{{"shadow_rays", "neepp"}, {"min_occluded", "1.5"}})),
                  std::invalid_argument);

@@ -37,6 +37,7 @@ std::unique_ptr<Integrator> make_integrator(const std::string &name, const Optio
             n.learn_until = options.get_int("learn_until", n.learn_until);
             if (n.learn_until < 1) throw std::invalid_argument("learn_until must be at least 1");
             n.min_occluded = options.get_float("min_occluded", n.min_occluded);
+            n.defer_seeding = !needs_map;  // a light sampler reading the map needs it from the first pass
             if (!(n.min_occluded >= 0.f && n.min_occluded <= 1.f)) throw std::invalid_argument("min_occluded must be in [0, 1]");
             if (n.policy == ShadowRayPolicy::NeeppAdaptive) {
                 n.adaptive_target = options.get_string("adaptive_target", n.adaptive_target);

@@ -74,6 +74,7 @@ ShadowTest NeeppShadowRays::begin_test(const ShadowQuery &q, Sampler &sampler, R
     ThreadState &ts = threads_.local();
     if (options_.learn) test.learn_pair = pair;
     if (options_.policy == ShadowRayPolicy::TraceAll) return test;  // learns, never reads the map
+    if (phase_ == Phase::Probe && map_.pair_count() == 0) return test;  // seeding deferred: nothing to read
     const PairCounts c = map_.counts_at(pair);
     if (c.traced >= options_.learn_until) test.learn_pair = ShadowTest::kNoPair;
     if (phase_ == Phase::Probe) return test;  // the first pass traces every query
@@ -153,12 +154,19 @@ void NeeppShadowRays::prepare(const Scene &scene) {
         map_source_ = "loaded";
         return;
     }
+    scene_ = &scene;
+    map_ = VisibilityMap();
+    map_source_ = "not built";
+    if (!options_.defer_seeding || options_.policy == ShadowRayPolicy::TraceAll) seed_map(scene);
+}
+
+void NeeppShadowRays::seed_map(const Scene &scene) {
     map_ = VisibilityMap(grid_.cell_count());
     SeedingOptions so;
     so.samples_per_pair = options_.samples_per_pair;
     seeding_ = seed_visibility_map(scene, grid_, map_, so);
     map_source_ = "built";
-    if (!options_.map_file.empty()) save_visibility_map(options_.map_file, grid_, map_, fingerprint);
+    if (!options_.map_file.empty()) save_visibility_map(options_.map_file, grid_, map_, scene_fingerprint(scene));
 }
 
 void NeeppShadowRays::calibrate_adaptive(const std::vector<uint64_t> &histogram, uint64_t roulettes,
@@ -186,6 +194,13 @@ void NeeppShadowRays::calibrate_adaptive(const std::vector<uint64_t> &histogram,
 
 void NeeppShadowRays::end_pass(const PassStatistics &pass) {
     auto t0 = std::chrono::steady_clock::now();
+    if (phase_ == Phase::Probe && options_.policy != ShadowRayPolicy::TraceAll) {
+        uint64_t traced = 0, occluded = 0;
+        for (const ThreadState &ts : threads_) traced += ts.probe_traced, occluded += ts.probe_occluded;
+        const double fraction = traced ? double(occluded) / double(traced) : 1.0;
+        phase_ = fraction >= double(options_.min_occluded) ? Phase::Rejecting : Phase::Off;
+        if (phase_ == Phase::Rejecting && map_.pair_count() == 0) seed_map(*scene_);
+    }
     // Sum every thread's updates per pair first (exact integer sums: independent of how tiles were spread
     // over threads and of the order below), then apply each pair's sum once.
     PairUpdateBuffer merged;
@@ -213,12 +228,15 @@ void NeeppShadowRays::end_pass(const PassStatistics &pass) {
         totals_.probe_occluded += ts.probe_occluded;
         ts.probe_traced = ts.probe_occluded = 0;
     }
-    merged.for_each([&](uint64_t pair, uint32_t v, uint32_t t) {
-        map_.add(pair, v, t);
-        totals_.updates_merged += t;
-    });
-    if (phase_ == Phase::Probe && options_.policy != ShadowRayPolicy::TraceAll)
-        phase_ = occluded_fraction() >= double(options_.min_occluded) ? Phase::Rejecting : Phase::Off;
+    // Pairs at learn_until take nothing more; begin_test already left them out, except in a first pass
+    // whose map was only seeded after it.
+    const bool capped = options_.policy != ShadowRayPolicy::TraceAll;
+    if (map_.pair_count() != 0)  // else rejection is off and the map was never built: nothing to learn
+        merged.for_each([&](uint64_t pair, uint32_t v, uint32_t t) {
+            if (capped && map_.counts_at(pair).traced >= options_.learn_until) return;
+            map_.add(pair, v, t);
+            totals_.updates_merged += t;
+        });
     if (options_.policy == ShadowRayPolicy::NeeppAdaptive) {
         if (options_.adaptive_target == "rays") calibrate_adaptive(histogram, roulettes, paper_q);
         else if (pass.sample_variance > 0)
