@@ -10,6 +10,7 @@
 #include "neepp/materials/roughconductor.h"
 #include "neepp/materials/roughplastic.h"
 #include "neepp/materials/thindielectric.h"
+#include "neepp/materials/twosided.h"
 #include "neepp/sampling/rng.h"
 
 namespace neepp {
@@ -60,6 +61,30 @@ TEST(BSDFProperties, SampleWeightIsEvalOverPdfForSmoothLobes) {
             ++checked;
         }
     EXPECT_GT(checked, 10000);
+}
+
+// eval_pdf (what next event estimation calls) is eval and pdf at once, including through the wrappers
+// that forward it and for directions on either side.
+TEST(BSDFProperties, EvalPdfIsEvalAndPdf) {
+    std::vector<BSDFPtr> bsdfs = glossy_bsdfs();
+    const BSDFPtr rp = bsdfs[4], rc = bsdfs[1];
+    bsdfs.push_back(std::make_shared<TwoSidedBSDF>(rp, rc));
+    bsdfs.push_back(std::make_shared<MaskBSDF>(constant_texture(0.6f), rc));
+    bsdfs.push_back(std::make_shared<BumpMapBSDF>(constant_texture(0.3f), 1.f, rp));
+    PCG32 rng(11, 3);
+    SurfaceInteraction si;
+    int nonzero = 0;
+    for (const auto &bsdf : bsdfs)
+        for (int i = 0; i < 500; ++i) {
+            const Vec3 wi = random_direction(rng, false), wo = random_direction(rng, false);
+            si.wi = wi;
+            const BSDFEval e = bsdf->eval_pdf(kRadiance, si, wi, wo);
+            const Color f = bsdf->eval(kRadiance, si, wi, wo);
+            for (int c = 0; c < 3; ++c) EXPECT_FLOAT_EQ(e.f[c], f[c]);
+            EXPECT_FLOAT_EQ(e.pdf, bsdf->pdf(kRadiance, si, wi, wo));
+            nonzero += e.pdf > 0 && !is_black(e.f);
+        }
+    EXPECT_GT(nonzero, 1000);
 }
 
 TEST(BSDFProperties, ReflectionIsReciprocalAndOneSided) {

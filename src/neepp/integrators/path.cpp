@@ -144,11 +144,10 @@ bool PathIntegrator::begin_direct(Path &path) const {
     if (!(ds.pdf > 0) || is_black(Le)) return false;
     Vec3 wo = si.to_local(ds.d);
     const BSDF &bsdf = *si.shape->bsdf;
-    BSDFContext bctx;
-    Color f = bsdf.eval(bctx, si, si.wi, wo);
+    const auto [f, bsdf_pdf] = bsdf.eval_pdf(BSDFContext{}, si, si.wi, wo);
     if (is_black(f)) return false;
     float light_pdf = ds.pdf * sl.pmf;
-    float w = ds.delta ? 1.f : mis_power(light_pdf, bsdf.pdf(bctx, si, si.wi, wo));
+    float w = ds.delta ? 1.f : mis_power(light_pdf, bsdf_pdf);
     ShadowQuery &q = path.shadow = ShadowQuery{};  // nothing the policy kept from the last bounce
     q.ray = ds.dist >= kInfinity ? si.spawn_ray(ds.d) : si.spawn_ray_to(ds.p);
     q.from = si.p;

@@ -51,11 +51,23 @@ struct BSDFSample {
     bool valid() const { return pdf > 0 && !is_black(weight); }
 };
 
+// f·|cos θo| and the density of sampling wo, for one pair of directions.
+struct BSDFEval {
+    Color f{0.f};
+    float pdf = 0;
+};
+
 class BSDF {
 public:
     virtual ~BSDF() = default;
     virtual Color eval(const BSDFContext &ctx, const SurfaceInteraction &si, const Vec3 &wi, const Vec3 &wo) const = 0;
     virtual float pdf(const BSDFContext &ctx, const SurfaceInteraction &si, const Vec3 &wi, const Vec3 &wo) const = 0;
+    // eval and pdf at once: next event estimation needs both (the contribution and its MIS weight), and
+    // they share the half vector, the microfacet terms and the texture lookups, which a BSDF that
+    // overrides this computes once. Must equal {eval(), pdf()}; the default calls the two.
+    virtual BSDFEval eval_pdf(const BSDFContext &ctx, const SurfaceInteraction &si, const Vec3 &wi, const Vec3 &wo) const {
+        return {eval(ctx, si, wi, wo), pdf(ctx, si, wi, wo)};
+    }
     // u1 chooses a lobe, u2 the direction within it.
     virtual BSDFSample sample(const BSDFContext &ctx, const SurfaceInteraction &si, const Vec3 &wi, float u1,
                               Vec2 u2) const = 0;

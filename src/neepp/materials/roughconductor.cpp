@@ -19,26 +19,22 @@ Color RoughConductorBSDF::fresnel(const SurfaceInteraction &si, float cos_theta)
     return fresnel_conductor(cos_theta, eta_->eval(si), k_->eval(si)) * specular_reflectance_->eval(si);
 }
 
-Color RoughConductorBSDF::eval(const BSDFContext &, const SurfaceInteraction &si, const Vec3 &wi,
-                               const Vec3 &wo) const {
-    if (wi.z <= 0.f || wo.z <= 0.f) return Color(0.f);
+BSDFEval RoughConductorBSDF::eval_pdf(const BSDFContext &, const SurfaceInteraction &si, const Vec3 &wi,
+                                      const Vec3 &wo) const {
+    if (wi.z <= 0.f || wo.z <= 0.f) return {};
     Vec3 h = normalize(wo + wi);
     MicrofacetDistribution distr = distribution(si);
-    float d = distr.eval(h);
-    if (d == 0.f) return Color(0.f);
+    const float d = distr.eval(h);
+    if (d == 0.f) return {};
+    BSDFEval r;
+    const float g1_i = distr.smith_g1(wi, h);
     // f cos_o = D G F / (4 cos_i cos_o) * cos_o
-    return fresnel(si, dot(wi, h)) * (d * distr.G(wi, wo, h) / (4.f * wi.z));
-}
-
-float RoughConductorBSDF::pdf(const BSDFContext &, const SurfaceInteraction &si, const Vec3 &wi,
-                              const Vec3 &wo) const {
-    Vec3 m = normalize(wo + wi);
-    // Same side tests that smith_g1 applies in eval() and sample().
-    if (wi.z <= 0.f || wo.z <= 0.f || dot(wi, m) <= 0.f || dot(wo, m) <= 0.f) return 0.f;
-    MicrofacetDistribution distr = distribution(si);
-    // Reflection Jacobian dm/dwo = 1 / (4 wo.m); with visible normals wo.m = wi.m cancels.
-    if (sample_visible_) return distr.eval(m) * distr.smith_g1(wi, m) / (4.f * wi.z);
-    return distr.pdf(wi, m) / (4.f * dot(wo, m));
+    r.f = fresnel(si, dot(wi, h)) * (d * (g1_i * distr.smith_g1(wo, h)) / (4.f * wi.z));
+    // Same side tests that smith_g1 applies in sample(). Reflection Jacobian dm/dwo = 1 / (4 wo.m); with
+    // visible normals wo.m = wi.m cancels.
+    if (dot(wi, h) <= 0.f || dot(wo, h) <= 0.f) return r;
+    r.pdf = sample_visible_ ? d * g1_i / (4.f * wi.z) : distr.pdf(wi, h) / (4.f * dot(wo, h));
+    return r;
 }
 
 BSDFSample RoughConductorBSDF::sample(const BSDFContext &, const SurfaceInteraction &si, const Vec3 &wi, float,

@@ -40,28 +40,28 @@ float RoughPlasticBSDF::prob_specular(float cos_theta_i) const {
     return p_s / (p_s + p_d);
 }
 
-Color RoughPlasticBSDF::eval(const BSDFContext &, const SurfaceInteraction &si, const Vec3 &wi,
-                             const Vec3 &wo) const {
-    if (wi.z <= 0.f || wo.z <= 0.f) return Color(0.f);
+BSDFEval RoughPlasticBSDF::eval_pdf(const BSDFContext &, const SurfaceInteraction &si, const Vec3 &wi,
+                                    const Vec3 &wo) const {
+    if (wi.z <= 0.f || wo.z <= 0.f) return {};
     Vec3 h = normalize(wo + wi);
+    const float d = distr_.eval(h), g1_i = distr_.smith_g1(wi, h);
     float f = fresnel_dielectric(dot(wi, h), eta_).r;
-    Color value = specular_reflectance_->eval(si) * (f * distr_.eval(h) * distr_.G(wi, wo, h) / (4.f * wi.z));
+    Color value = specular_reflectance_->eval(si) * (f * d * (g1_i * distr_.smith_g1(wo, h)) / (4.f * wi.z));
 
     // Diffuse base seen through the coating's transmittance both ways; the internal reflectance is
     // summed as a geometric series (per channel when nonlinear).
     Color diff = diffuse_reflectance_->eval(si);
     diff = diff / (nonlinear_ ? Color(1.f) - diff * internal_reflectance_ : Color(1.f - internal_reflectance_));
     float t_i = external_transmittance(wi.z), t_o = external_transmittance(wo.z);
-    return value + diff * (kInvPi * inv_eta_2_ * wo.z * t_i * t_o);
-}
+    BSDFEval r;
+    r.f = value + diff * (kInvPi * inv_eta_2_ * wo.z * t_i * t_o);
 
-float RoughPlasticBSDF::pdf(const BSDFContext &, const SurfaceInteraction &, const Vec3 &wi, const Vec3 &wo) const {
-    if (wi.z <= 0.f || wo.z <= 0.f) return 0.f;
-    float p_spec = prob_specular(wi.z);
-    Vec3 h = normalize(wo + wi);
-    float spec = distr_.sample_visible() ? distr_.eval(h) * distr_.smith_g1(wi, h) / (4.f * wi.z)
-                                         : distr_.pdf(wi, h) / (4.f * dot(wo, h));
-    return p_spec * spec + (1.f - p_spec) * square_to_cosine_hemisphere_pdf(wo);
+    // The lobes' mixture density (the specular lobe's probability from the same transmittance t_i).
+    float p_s = (1.f - t_i) * specular_sampling_weight_, p_d = t_i * (1.f - specular_sampling_weight_);
+    float p_spec = p_s / (p_s + p_d);
+    float spec = distr_.sample_visible() ? d * g1_i / (4.f * wi.z) : distr_.pdf(wi, h) / (4.f * dot(wo, h));
+    r.pdf = p_spec * spec + (1.f - p_spec) * square_to_cosine_hemisphere_pdf(wo);
+    return r;
 }
 
 BSDFSample RoughPlasticBSDF::sample(const BSDFContext &ctx, const SurfaceInteraction &si, const Vec3 &wi, float u1,
@@ -76,9 +76,10 @@ BSDFSample RoughPlasticBSDF::sample(const BSDFContext &ctx, const SurfaceInterac
         bs.sampled_flags = BSDFDiffuseReflection;
     }
     // Both lobes can produce either direction, so the weight uses the full mixture density.
-    bs.pdf = pdf(ctx, si, wi, bs.wo);
+    const BSDFEval e = eval_pdf(ctx, si, wi, bs.wo);
+    bs.pdf = e.pdf;
     if (!(bs.pdf > 0.f)) return BSDFSample{};
-    bs.weight = eval(ctx, si, wi, bs.wo) / bs.pdf;
+    bs.weight = e.f / bs.pdf;
     return bs;
 }
 

@@ -13,6 +13,11 @@ float TwoSidedBSDF::pdf(const BSDFContext &ctx, const SurfaceInteraction &si, co
     return wi.z >= 0 ? front_->pdf(ctx, si, wi, wo) : back_->pdf(ctx, si, flip_z(wi), flip_z(wo));
 }
 
+BSDFEval TwoSidedBSDF::eval_pdf(const BSDFContext &ctx, const SurfaceInteraction &si, const Vec3 &wi,
+                                const Vec3 &wo) const {
+    return wi.z >= 0 ? front_->eval_pdf(ctx, si, wi, wo) : back_->eval_pdf(ctx, si, flip_z(wi), flip_z(wo));
+}
+
 BSDFSample TwoSidedBSDF::sample(const BSDFContext &ctx, const SurfaceInteraction &si, const Vec3 &wi, float u1,
                                 Vec2 u2) const {
     if (wi.z >= 0) return front_->sample(ctx, si, wi, u1, u2);
@@ -27,6 +32,12 @@ Color MaskBSDF::eval(const BSDFContext &ctx, const SurfaceInteraction &si, const
 
 float MaskBSDF::pdf(const BSDFContext &ctx, const SurfaceInteraction &si, const Vec3 &wi, const Vec3 &wo) const {
     return nested_->pdf(ctx, si, wi, wo) * opacity(si);
+}
+
+BSDFEval MaskBSDF::eval_pdf(const BSDFContext &ctx, const SurfaceInteraction &si, const Vec3 &wi, const Vec3 &wo) const {
+    BSDFEval e = nested_->eval_pdf(ctx, si, wi, wo);
+    const float a = opacity(si);
+    return {e.f * a, e.pdf * a};
 }
 
 BSDFSample MaskBSDF::sample(const BSDFContext &ctx, const SurfaceInteraction &si, const Vec3 &wi, float u1,
@@ -82,6 +93,13 @@ float BumpMapBSDF::pdf(const BSDFContext &ctx, const SurfaceInteraction &si, con
     Vec3 wi_p;
     SurfaceInteraction p = perturbed(si, wi, wi_p);
     return nested_->pdf(ctx, p, wi_p, p.to_local(si.to_world(wo)));
+}
+
+BSDFEval BumpMapBSDF::eval_pdf(const BSDFContext &ctx, const SurfaceInteraction &si, const Vec3 &wi,
+                               const Vec3 &wo) const {
+    Vec3 wi_p;
+    SurfaceInteraction p = perturbed(si, wi, wi_p);  // once for both (a texture gradient lookup)
+    return nested_->eval_pdf(ctx, p, wi_p, p.to_local(si.to_world(wo)));
 }
 
 BSDFSample BumpMapBSDF::sample(const BSDFContext &ctx, const SurfaceInteraction &si, const Vec3 &wi, float u1,
