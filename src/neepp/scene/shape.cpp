@@ -18,6 +18,16 @@ void Shape::finalize() {
     }
     area_ = float(total);
     triangle_distribution_ = Distribution1D(std::move(areas));
+    sampling_triangles_.clear();
+    if (area_light)
+        for (size_t i = 0; i < triangle_count(); ++i) sampling_triangles_.push_back(sampling_triangle(i));
+}
+
+Shape::SamplingTriangle Shape::sampling_triangle(size_t tri) const {
+    if (tri < sampling_triangles_.size()) return sampling_triangles_[tri];
+    const Vec3 &p0 = positions[indices[3 * tri]], &p1 = positions[indices[3 * tri + 1]], &p2 = positions[indices[3 * tri + 2]];
+    const Vec3 n = normalize(cross(p1 - p0, p2 - p0));
+    return {p0, p1 - p0, p2 - p0, flip_normals ? -n : n};
 }
 
 BBox Shape::bounds() const {
@@ -43,14 +53,17 @@ PositionSample Shape::sample_position(Vec2 u) const {
     float ux = u.x;
     uint32_t tri = triangle_distribution_.sample_reuse(ux);
     Vec2 b = square_to_uniform_triangle({ux, u.y});
-    uint32_t i0 = indices[3 * tri], i1 = indices[3 * tri + 1], i2 = indices[3 * tri + 2];
-    const Vec3 &p0 = positions[i0], &p1 = positions[i1], &p2 = positions[i2];
-    ps.p = p0 * (1.f - b.x - b.y) + p1 * b.x + p2 * b.y;
-    ps.n = normalize(cross(p1 - p0, p2 - p0));
+    const SamplingTriangle t = sampling_triangle(tri);
+    ps.p = t.p0 + t.e1 * b.x + t.e2 * b.y;
+    ps.n = t.n;
     // Same uv as a ray hit at this point gets (barycentrics without texture coordinates), so textured
     // emission agrees between light sampling and BSDF sampling.
-    ps.uv = uvs.empty() ? b : uvs[i0] * (1.f - b.x - b.y) + uvs[i1] * b.x + uvs[i2] * b.y;
-    if (flip_normals) ps.n = -ps.n;
+    if (uvs.empty()) {
+        ps.uv = b;
+    } else {
+        const uint32_t i0 = indices[3 * tri], i1 = indices[3 * tri + 1], i2 = indices[3 * tri + 2];
+        ps.uv = uvs[i0] * (1.f - b.x - b.y) + uvs[i1] * b.x + uvs[i2] * b.y;
+    }
     return ps;
 }
 

@@ -55,8 +55,17 @@ struct Shape {
     void prefetch(uint32_t prim, int level) const;
 
 private:
+    // What sampling a point on one triangle reads: a corner, the two edges from it and the unit face
+    // normal (flipped if asked), one 48-byte record instead of three indices, three vertices and a
+    // normalization per light sample.
+    struct SamplingTriangle {
+        Vec3 p0, e1, e2, n;
+    };
+    SamplingTriangle sampling_triangle(size_t tri) const;
+
     float area_ = 0;
     Distribution1D triangle_distribution_;
+    std::vector<SamplingTriangle> sampling_triangles_;  // precomputed for emitters (sampled at every NEE)
 };
 
 }  // namespace neepp
