@@ -88,6 +88,9 @@ def main(argv=None) -> int:
     ap.add_argument("--spp", default="4,64,1024", help="comma-separated sample counts")
     ap.add_argument("--policies", default=",".join(POLICIES))
     ap.add_argument("--scale", type=int, default=4, help="divide the reference resolution by this")
+    ap.add_argument("--equal-time-spp", type=int, default=0,
+                    help="equal-time budget = nee's time at this sample count (one of --spp; default the middle "
+                         "one). A longer budget weighs seeding and the machine's noise less")
     ap.add_argument("--max-depth", type=int, default=17)
     ap.add_argument("--threads", type=int, default=0)
     ap.add_argument("--seed", type=int, default=1)
@@ -97,6 +100,8 @@ def main(argv=None) -> int:
     a = ap.parse_args(argv)
     options = dict(o.split("=", 1) for o in a.options)
     spps = [int(x) for x in a.spp.split(",")]
+    if a.equal_time_spp and a.equal_time_spp not in spps:
+        ap.error(f"--equal-time-spp {a.equal_time_spp} is not one of --spp {a.spp}")
     policies = a.policies.split(",")
     out = Path(a.out)
     out.mkdir(parents=True, exist_ok=True)
@@ -118,8 +123,8 @@ def main(argv=None) -> int:
             md.append(f"\n### equal spp: {spp}\n\n" + table(rows) + "\n")
             report.comparison_figure(out / scene / f"compare_{spp}spp.png", images, ref=ref,
                                      title=f"{scene}: {spp} spp", credit=credit(scene))
-        # Equal time: every policy gets the wall time `nee` used at the middle sample count.
-        mid = spps[len(spps) // 2]
+        # Equal time: every policy gets the wall time `nee` used at the middle (or chosen) sample count.
+        mid = a.equal_time_spp or spps[len(spps) // 2]
         budget = next(r for r in results[scene]["equal_spp"][mid] if r["policy"] == "nee")["render_s"]
         rows, equal_time_images = run_policies(policies, "equal_time", ref, lambda policy, name: render(
             xml, out / scene / name, policy, time_s=budget, w=w, h=h, max_depth=a.max_depth, seed=a.seed,
