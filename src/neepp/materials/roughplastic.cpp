@@ -34,8 +34,7 @@ float RoughPlasticBSDF::external_transmittance(float cos_theta) const {
     return external_transmittance_[index] * (1.f - t) + external_transmittance_[index + 1] * t;
 }
 
-float RoughPlasticBSDF::prob_specular(float cos_theta_i) const {
-    float t_i = external_transmittance(cos_theta_i);
+float RoughPlasticBSDF::prob_specular(float t_i) const {
     float p_s = (1.f - t_i) * specular_sampling_weight_, p_d = t_i * (1.f - specular_sampling_weight_);
     return p_s / (p_s + p_d);
 }
@@ -57,8 +56,7 @@ BSDFEval RoughPlasticBSDF::eval_pdf(const BSDFContext &, const SurfaceInteractio
     r.f = value + diff * (kInvPi * inv_eta_2_ * wo.z * t_i * t_o);
 
     // The lobes' mixture density (the specular lobe's probability from the same transmittance t_i).
-    float p_s = (1.f - t_i) * specular_sampling_weight_, p_d = t_i * (1.f - specular_sampling_weight_);
-    float p_spec = p_s / (p_s + p_d);
+    float p_spec = prob_specular(t_i);
     float spec = distr_.sample_visible() ? d * g1_i / (4.f * wi.z) : distr_.pdf(wi, h) / (4.f * dot(wo, h));
     r.pdf = p_spec * spec + (1.f - p_spec) * square_to_cosine_hemisphere_pdf(wo);
     return r;
@@ -68,7 +66,7 @@ BSDFSample RoughPlasticBSDF::sample(const BSDFContext &ctx, const SurfaceInterac
                                     Vec2 u2) const {
     BSDFSample bs;
     if (wi.z <= 0.f) return bs;
-    if (u1 < prob_specular(wi.z)) {
+    if (u1 < prob_specular(external_transmittance(wi.z))) {
         bs.wo = reflect(wi, distr_.sample(wi, u2).first);
         bs.sampled_flags = BSDFGlossyReflection;
     } else {

@@ -43,7 +43,8 @@ public:
     float internal_reflectance() const { return internal_reflectance_; }
 
 private:
-    float prob_specular(float cos_theta_i) const;
+    // Probability of sampling the specular lobe, from the coating's transmittance t_i toward wi.
+    float prob_specular(float t_i) const;
 
     MicrofacetDistribution distr_;
     float eta_, inv_eta_2_;

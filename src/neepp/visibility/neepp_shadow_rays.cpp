@@ -201,13 +201,6 @@ void NeeppShadowRays::calibrate_adaptive(const std::vector<uint64_t> &histogram,
 
 void NeeppShadowRays::end_pass(const PassStatistics &pass) {
     auto t0 = std::chrono::steady_clock::now();
-    if (phase_ == Phase::Probe && options_.policy != ShadowRayPolicy::TraceAll) {
-        uint64_t traced = 0, occluded = 0;
-        for (const ThreadState &ts : threads_) traced += ts.probe_traced, occluded += ts.probe_occluded;
-        const double fraction = traced ? double(occluded) / double(traced) : 1.0;
-        phase_ = fraction >= double(options_.min_occluded) ? Phase::Rejecting : Phase::Off;
-        if (phase_ == Phase::Rejecting && map_.pair_count() == 0) seed_map(*scene_);
-    }
     // Sum every thread's updates per pair first (exact integer sums: independent of how tiles were spread
     // over threads and of the order below), then apply each pair's sum once.
     PairUpdateBuffer merged;
@@ -234,6 +227,10 @@ void NeeppShadowRays::end_pass(const PassStatistics &pass) {
         totals_.probe_traced += ts.probe_traced;
         totals_.probe_occluded += ts.probe_occluded;
         ts.probe_traced = ts.probe_occluded = 0;
+    }
+    if (phase_ == Phase::Probe && options_.policy != ShadowRayPolicy::TraceAll) {
+        phase_ = occluded_fraction() >= double(options_.min_occluded) ? Phase::Rejecting : Phase::Off;
+        if (phase_ == Phase::Rejecting && map_.pair_count() == 0) seed_map(*scene_);  // deferred seeding
     }
     // Pairs at learn_until take nothing more; begin_test already left them out, except in a first pass
     // whose map was only seeded after it.

@@ -18,8 +18,9 @@
 // the policy stops rejecting for the rest of the render (the paper's stated limitation: scenes with simple
 // visibility have little to gain, and a lookup per query plus the roulette's variance would cost more).
 // With defer_seeding the map is seeded only once that decision is made (the first pass learns into
-// per-thread buffers, merged into the seeded map). The decision reads counts, not timings, so renders stay reproducible; every pass is unbiased whichever
-// way it went, since it is taken before the pass it applies to.
+// per-thread buffers, merged into the seeded map). The decision reads counts, not timings, so renders
+// stay reproducible; every pass is unbiased whichever way it went, since it is taken before the pass it
+// applies to.
 // In every policy, pairs the map has never seen and same-voxel pairs (whose visibility the map cannot
 // resolve) are always traced, and q >= q_min > 0, so no sample with V = 1 is ever given zero probability.
 // Every traced ray also updates its pair's counts: per-thread buffers during a pass, merged by
@@ -104,9 +105,6 @@ public:
     // Adaptive policy's current scale c (0 = not calibrated yet: the paper's rule is used).
     double adaptive_scale() const { return adaptive_scale_; }
     void set_adaptive_scale(double c) { adaptive_scale_ = c; }
-    // Whether the roulette runs in the passes to come: false during the first pass (it traces everything)
-    // and after it if too few of its rays were occluded (min_occluded).
-    bool rejecting() const { return phase_ == Phase::Rejecting; }
     // Occluded fraction of the first pass's shadow rays (1 before any: no reason yet to turn off).
     double occluded_fraction() const {
         return totals_.probe_traced ? double(totals_.probe_occluded) / double(totals_.probe_traced) : 1.0;
