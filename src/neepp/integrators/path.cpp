@@ -217,7 +217,9 @@ void PathIntegrator::Li_batch(const Scene &scene, std::span<const Ray> rays, std
                 RayHit *hs[16];
                 const int m = int(std::min<size_t>(16, live - k0));
                 for (int j = 0; j < m; ++j) rs[j] = &paths[active[k0 + j]].ray, hs[j] = &paths[active[k0 + j]].hit;
-                scene.trace16(rs, hs, m);
+                // Camera rays (paths advance in lockstep, so all of a packet are at one depth) leave one
+                // pixel or a few neighbours: Embree's coherent traversal suits them.
+                scene.trace16(rs, hs, m, paths[active[k0]].depth == 0);
                 counters.rays += m;
                 for (int j = 0; j < m; ++j) scene.prefetch(*hs[j], 0);
             }

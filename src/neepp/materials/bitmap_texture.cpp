@@ -130,8 +130,15 @@ BitmapTexture::Lookup BitmapTexture::locate(Vec2 uv) const {
     Lookup l;
     l.wx1 = px - fx, l.wx0 = 1.f - l.wx1;
     l.wy1 = py - fy, l.wy0 = 1.f - l.wy1;
-    l.x0 = wrap(ix, width_, options_.wrap), l.x1 = wrap(ix + 1, width_, options_.wrap);
-    l.y0 = wrap(iy, height_, options_.wrap), l.y1 = wrap(iy + 1, height_, options_.wrap);
+    l.x0 = wrap(ix, width_, options_.wrap), l.y0 = wrap(iy, height_, options_.wrap);
+    if (options_.wrap == WrapMode::Repeat) {
+        // The upper neighbour wraps with the lower one: a modulo is not needed twice (tiled textures' uv
+        // lie outside [0, 1), where wrap divides).
+        l.x1 = l.x0 + 1 == width_ ? 0 : l.x0 + 1;
+        l.y1 = l.y0 + 1 == height_ ? 0 : l.y0 + 1;
+    } else {
+        l.x1 = wrap(ix + 1, width_, options_.wrap), l.y1 = wrap(iy + 1, height_, options_.wrap);
+    }
     return l;
 }
 

@@ -122,9 +122,10 @@ RayHit Scene::trace(const Ray &ray) const {
     return hit;
 }
 
-void Scene::trace16(const Ray *const *rays, RayHit *const *hits, int n) const {
+void Scene::trace16(const Ray *const *rays, RayHit *const *hits, int n, bool coherent) const {
     RTCIntersectContext ctx;
     rtcInitIntersectContext(&ctx);
+    if (coherent) ctx.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
     alignas(64) int valid[16];
     alignas(64) RTCRayHit16 rh;
     to_embree16(rays, n, rh.ray, valid);
