@@ -87,6 +87,23 @@ TEST(BitmapTexture, WrapModesAtTheBorder) {
     EXPECT_FLOAT_EQ(column(WrapMode::Clamp, W + 3), W - 1);
 }
 
+TEST(BitmapTexture, RepeatedLookupsAtOnePointAgreeWithFreshOnes) {
+    // eval keeps its last lookup in the SurfaceInteraction: a second lookup at the same point must give
+    // the same value, one at another uv (same object, moved) or of another texture must not get it.
+    BitmapTexture a(coords_image(W, H)), b(coords_image(2 * W, 2 * H));
+    SurfaceInteraction si = at_uv(0.3f, 0.6f);
+    const Color first = a.eval(si);
+    expect_color(a.eval(si), first, 0.f);
+    expect_color(b.eval(si), b.eval(at_uv(0.3f, 0.6f)), 0.f);
+    EXPECT_NE(b.eval(si).x, first.x);
+    expect_color(a.eval(si), first, 0.f);
+    for (float u : {0.1f, 0.35f, 0.8f, 1.7f, -0.4f}) {
+        si.uv = Vec2(u, 0.6f);
+        expect_color(a.eval(si), a.eval(at_uv(u, 0.6f)), 0.f);
+        EXPECT_NE(a.eval(si).x, first.x) << "stale value at u=" << u;
+    }
+}
+
 TEST(BitmapTexture, NearestHasNoHalfTexelShift) {
     BitmapOptions o;
     o.filter = FilterType::Nearest;

@@ -167,7 +167,13 @@ void BitmapTexture::prefetch(const SurfaceInteraction &si) const {
     }
 }
 
-Color BitmapTexture::eval(const SurfaceInteraction &si) const { return interpolate(to_uv_.apply(si.uv)); }
+Color BitmapTexture::eval(const SurfaceInteraction &si) const {
+    SurfaceInteraction::TextureMemo &memo = si.texture_memo;
+    if (memo.texture == this && memo.uv.x == si.uv.x && memo.uv.y == si.uv.y) return memo.value;
+    const Color c = interpolate(to_uv_.apply(si.uv));
+    memo = {this, si.uv, c};
+    return c;
+}
 
 float BitmapTexture::eval_1(const SurfaceInteraction &si) const {
     const Color c = interpolate(to_uv_.apply(si.uv));
