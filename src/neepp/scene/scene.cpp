@@ -1,5 +1,6 @@
 #include "neepp/scene/scene.h"
 
+#include <algorithm>
 #include <cstdio>
 #include <stdexcept>
 #include <string>
@@ -20,15 +21,19 @@ void to_embree(const Ray &ray, RTCRay &r) {
     r.time = 0; r.mask = 0xFFFFFFFFu; r.id = 0; r.flags = 0;
 }
 
-// A packet of rays[0..n); the lanes beyond n repeat ray 0 and are marked invalid.
+// A packet of rays[0..n); the lanes beyond n repeat ray 0 and are marked invalid. The fields that are
+// the same in every lane are written whole (whole-vector stores), the rays lane by lane.
 void to_embree16(const Ray *const *rays, int n, RTCRay16 &r, int *valid) {
+    std::fill_n(r.time, 16, 0.f);
+    std::fill_n(r.mask, 16, 0xFFFFFFFFu);
+    std::fill_n(r.id, 16, 0u);
+    std::fill_n(r.flags, 16, 0u);
+    for (int i = 0; i < 16; ++i) valid[i] = i < n ? -1 : 0;
     for (int i = 0; i < 16; ++i) {
-        valid[i] = i < n ? -1 : 0;
         const Ray &ray = *rays[i < n ? i : 0];
         r.org_x[i] = ray.o.x; r.org_y[i] = ray.o.y; r.org_z[i] = ray.o.z;
         r.dir_x[i] = ray.d.x; r.dir_y[i] = ray.d.y; r.dir_z[i] = ray.d.z;
         r.tnear[i] = ray.tmin; r.tfar[i] = ray.tmax;
-        r.time[i] = 0; r.mask[i] = 0xFFFFFFFFu; r.id[i] = 0; r.flags[i] = 0;
     }
 }
 
