@@ -30,12 +30,14 @@ void PathIntegrator::prepare(const Scene &scene) {
         !light_sampler_needs_visibility_map(options_.light_sampler, scene.lights().size()))
         shadow_ = std::make_unique<TraceAllShadowRays>();
     shadow_->prepare(scene);  // NEE++: build or load the visibility map
+    queries_ = &shadow_->query_tester();
     LightSelectionInputs inputs{&scene, shadow_->voxel_grid(), shadow_->visibility_map(), options_.voxels};
     light_sampler_ = make_light_sampler(options_.light_sampler, scene.light_pointers(), inputs);
 }
 
 void PathIntegrator::end_pass(const Scene &, const PassStatistics &pass) {
     shadow_->end_pass(pass);     // NEE++: merge what the pass learned into the map the next pass reads
+    queries_ = &shadow_->query_tester();  // ... or, its rejection off, leave the queries to plain NEE
     light_sampler_->end_pass();  // ... and rebuild the light distributions that read it
 }
 
@@ -153,19 +155,19 @@ bool PathIntegrator::begin_direct(Path &path) const {
     q.from = si.p;
     q.to = ds.p;
     q.unoccluded = path.beta * f * Le * (w / light_pdf);
-    shadow_->prepare(q);
+    queries_->prepare(q);
     return true;
 }
 
 bool PathIntegrator::decide_direct(Path &path, RenderCounters &counters) const {
-    path.test = shadow_->begin_test(path.shadow, *path.sampler, counters);
+    path.test = queries_->begin_test(path.shadow, *path.sampler, counters);
     if (path.test.trace) return true;
     path.L += path.shadow.unoccluded * path.test.if_skipped;
     return false;
 }
 
 void PathIntegrator::end_direct(Path &path, bool occluded) const {
-    shadow_->end_test(path.test, occluded);
+    queries_->end_test(path.test, occluded);
     path.L += path.shadow.unoccluded * path.test.weight(occluded);
 }
 

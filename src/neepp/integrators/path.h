@@ -59,6 +59,7 @@ private:
 
     PathOptions options_;
     std::unique_ptr<ShadowRayTester> shadow_;
+    const ShadowRayTester *queries_ = nullptr;  // shadow_->query_tester() for the coming pass
     std::unique_ptr<LightSampler> light_sampler_;
 };
 

@@ -66,10 +66,15 @@ void NeeppShadowRays::prepare(ShadowQuery &q) const {
         map_.prefetch(VisibilityMap::pair_index(q.from_cell, q.to_cell));
 }
 
+const ShadowRayTester &NeeppShadowRays::query_tester() const {
+    static const TraceAllShadowRays trace_all;  // stateless
+    return phase_ == Phase::Off ? static_cast<const ShadowRayTester &>(trace_all) : *this;
+}
+
 ShadowTest NeeppShadowRays::begin_test(const ShadowQuery &q, Sampler &sampler, RenderCounters &counters) const {
-    // With rejection off, plain NEE from here on: no lookup, no learning. Kept apart from the rest so this
-    // path, taken by every query of such a render, skips the rest's register saves (callgrind, cornell:
-    // ~25 instructions a query).
+    // With rejection off, plain NEE from here on: no lookup, no learning (the path integrator then asks
+    // query_tester() instead and does not come here; other callers may). Kept apart from the rest so this
+    // path skips the rest's register saves (callgrind, cornell: ~25 instructions a query).
     if (phase_ == Phase::Off) return ShadowTest{};
     return decide(q, sampler, counters);
 }

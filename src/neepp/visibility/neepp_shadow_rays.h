@@ -110,6 +110,8 @@ public:
         return totals_.probe_traced ? double(totals_.probe_occluded) / double(totals_.probe_traced) : 1.0;
     }
 
+    // With rejection off (after the first pass), plain NEE: the same answers (trace all, learn nothing).
+    const ShadowRayTester &query_tester() const override;
     const VoxelGrid *voxel_grid() const override { return &grid_; }
     const VisibilityMap *visibility_map() const override { return &map_; }
     const NeeppOptions &options() const { return options_; }

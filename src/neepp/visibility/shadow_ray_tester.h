@@ -69,6 +69,11 @@ public:
     // selection); valid after prepare(), updated by end_pass().
     virtual const VoxelGrid *voxel_grid() const { return nullptr; }
     virtual const VisibilityMap *visibility_map() const { return nullptr; }
+    // The tester that answers the coming pass's queries (prepare(q), begin_test, end_test): itself, or
+    // one that answers them the same way at less cost. NEE++ whose rejection stays off hands them to plain
+    // NEE, so such a render costs per query exactly what `nee` does. Read after prepare(scene) and after
+    // each end_pass(); valid as long as this tester.
+    virtual const ShadowRayTester &query_tester() const { return *this; }
 };
 
 // Plain next event estimation: every shadow ray is traced.
