@@ -251,6 +251,8 @@ namespace {
 struct GuardedRun {
     RenderCounters counters;
     nlohmann::json rejection, map;
+    bool queries_delegated = false;  // the path integrator's queries went to another tester after the first pass
+    std::string query_policy;        // ... whose policy is this
 };
 
 GuardedRun render_two_rooms_guarded(const std::string &min_occluded, int spp) {
@@ -261,7 +263,9 @@ GuardedRun render_two_rooms_guarded(const std::string &min_occluded, int spp) {
     job.spp = spp;
     RenderResult r = render(*scene, *integ, job);
     const nlohmann::json stats = integ->statistics()["shadow_rays"];
-    return {r.counters, stats["rejection"], stats["map"]};
+    const ShadowRayTester &tester = dynamic_cast<const PathIntegrator &>(*integ).shadow_rays();
+    return {r.counters, stats["rejection"], stats["map"], &tester.query_tester() != &tester,
+            tester.query_tester().policy()};
 }
 
 }  // namespace
@@ -277,11 +281,14 @@ TEST(NeeppRender, RejectionNeedsEnoughOccludedShadowRays) {
 
     GuardedRun on = render_two_rooms_guarded(std::to_string(fraction - 0.01), 8);
     EXPECT_EQ(on.rejection["state"], "on");
+    EXPECT_FALSE(on.queries_delegated);
     EXPECT_GT(on.counters.shadow_rays_skipped, 0u);
     EXPECT_EQ(on.map["source"], "built") << "seeded after the first pass";
     EXPECT_GT(on.map["build_shadow_rays"].get<uint64_t>(), 0u);
     GuardedRun off = render_two_rooms_guarded(std::to_string(fraction + 0.01), 8);
     EXPECT_EQ(off.rejection["state"], "off");
+    EXPECT_TRUE(off.queries_delegated) << "with rejection off, queries cost what plain NEE's do";
+    EXPECT_EQ(off.query_policy, "nee");
     EXPECT_EQ(off.counters.shadow_rays_skipped, 0u);
     EXPECT_EQ(off.map["source"], "not built") << "no map is seeded for a render that will not use it";
     EXPECT_EQ(off.map["build_shadow_rays"].get<uint64_t>(), 0u);
