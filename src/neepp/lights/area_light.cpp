@@ -3,7 +3,7 @@
 namespace neepp {
 
 DirectionSample AreaLight::sample_direction(const Vec3 &ref, Vec2 u, Color &radiance) const {
-    PositionSample ps = shape_->sample_position(u);
+    PositionSample ps = shape_->sample_position(u, !constant_);
     DirectionSample ds;
     ds.p = ps.p;
     ds.n = ps.n;
@@ -15,6 +15,10 @@ DirectionSample AreaLight::sample_direction(const Vec3 &ref, Vec2 u, Color &radi
     radiance = Color(0.f);
     if (cos_light <= 0 || !(dist2 > 0)) return ds;
     ds.pdf = ps.pdf * dist2 / cos_light;
+    if (constant_) {
+        radiance = constant_radiance_;
+        return ds;
+    }
     SurfaceInteraction si;
     si.p = ps.p; si.n = ps.n; si.uv = ps.uv;
     radiance = radiance_->eval(si);

@@ -8,7 +8,9 @@ namespace neepp {
 
 class AreaLight final : public Light {
 public:
-    AreaLight(const Shape *shape, TexturePtr radiance) : shape_(shape), radiance_(std::move(radiance)) {}
+    AreaLight(const Shape *shape, TexturePtr radiance)
+        : shape_(shape), radiance_(std::move(radiance)), constant_(radiance_->is_constant()),
+          constant_radiance_(radiance_->mean()) {}
     DirectionSample sample_direction(const Vec3 &ref, Vec2 u, Color &radiance) const override;
     float pdf_direction(const Vec3 &ref, const DirectionSample &ds) const override;
     Color eval_surface(const SurfaceInteraction &si, const Vec3 &w) const override;
@@ -20,6 +22,9 @@ public:
 private:
     const Shape *shape_;
     TexturePtr radiance_;
+    // Most emitters are uniform: a light sample then needs neither the point's uv nor a texture lookup.
+    bool constant_;
+    Color constant_radiance_;
 };
 
 }  // namespace neepp

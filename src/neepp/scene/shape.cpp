@@ -41,7 +41,7 @@ BBox Shape::bounds() const {
     return b;
 }
 
-PositionSample Shape::sample_position(Vec2 u) const {
+PositionSample Shape::sample_position(Vec2 u, bool with_uv) const {
     PositionSample ps;
     ps.pdf = pdf_position();
     if (kind == Kind::Sphere) {
@@ -58,6 +58,7 @@ PositionSample Shape::sample_position(Vec2 u) const {
     ps.n = t.n;
     // Same uv as a ray hit at this point gets (barycentrics without texture coordinates), so textured
     // emission agrees between light sampling and BSDF sampling.
+    if (!with_uv) return ps;
     if (uvs.empty()) {
         ps.uv = b;
     } else {

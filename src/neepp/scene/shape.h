@@ -45,7 +45,8 @@ struct Shape {
     BBox bounds() const;
 
     // Uniform sampling of a point by area.
-    PositionSample sample_position(Vec2 u) const;
+    // with_uv = false leaves ps.uv unset (a caller with nothing textured to look up skips its fetch).
+    PositionSample sample_position(Vec2 u, bool with_uv = true) const;
     float pdf_position() const { return area_ > 0 ? 1.f / area_ : 0.f; }
 
     // Completes a hit record from Embree's primitive index and barycentrics (or sphere hit).
