@@ -102,6 +102,26 @@ TEST(BitmapTexture, RepeatedLookupsAtOnePointAgreeWithFreshOnes) {
         expect_color(a.eval(si), a.eval(at_uv(u, 0.6f)), 0.f);
         EXPECT_NE(a.eval(si).x, first.x) << "stale value at u=" << u;
     }
+    // A prefetch leaves the located footprint for the next read: prefetched, then read, at a point, after
+    // a prefetch of another texture or uv, with nearest filtering too: always the fresh value.
+    BitmapOptions nearest;
+    nearest.filter = FilterType::Nearest;
+    BitmapTexture n(coords_image(W, H), nearest);
+    for (float u : {0.2f, 0.55f, 1.3f}) {
+        for (const BitmapTexture *t : {&a, &b, &n}) {
+            SurfaceInteraction p = at_uv(u, 0.7f);
+            t->prefetch(p);
+            expect_color(t->eval(p), t->eval(at_uv(u, 0.7f)), 0.f);
+            expect_color(t->eval(p), t->eval(at_uv(u, 0.7f)), 0.f);
+            SurfaceInteraction q = at_uv(u, 0.7f);
+            a.prefetch(q);
+            q.uv = Vec2(u + 0.25f, 0.7f);
+            expect_color(t->eval(q), t->eval(at_uv(u + 0.25f, 0.7f)), 0.f);
+            SurfaceInteraction r = at_uv(u, 0.7f);
+            b.prefetch(r);
+            expect_color(t->eval(r), t->eval(at_uv(u, 0.7f)), 0.f);
+        }
+    }
 }
 
 TEST(BitmapTexture, NearestHasNoHalfTexelShift) {

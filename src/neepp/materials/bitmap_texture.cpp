@@ -148,7 +148,10 @@ Color BitmapTexture::interpolate(Vec2 uv) const {
         const int x = int(std::floor(uv.x * float(width_))), y = int(std::floor(uv.y * float(height_)));
         return texel(wrap(x, width_, options_.wrap), wrap(y, height_, options_.wrap));
     }
-    const Lookup l = locate(uv);
+    return blend(locate(uv));
+}
+
+Color BitmapTexture::blend(const Lookup &l) const {
     // Same corner order and fused accumulation as Dr.Jit, so results agree to the last bit.
     const Color c[4] = {texel(l.x0, l.y0), texel(l.x1, l.y0), texel(l.x0, l.y1), texel(l.x1, l.y1)};
     const float w[4] = {l.wx0 * l.wy0, l.wx1 * l.wy0, l.wx0 * l.wy1, l.wx1 * l.wy1};
@@ -158,20 +161,38 @@ Color BitmapTexture::interpolate(Vec2 uv) const {
     return out;
 }
 
+namespace {
+bool memo_of(const SurfaceInteraction::TextureMemo &memo, const void *texture, Vec2 uv) {
+    return memo.texture == texture && memo.uv.x == uv.x && memo.uv.y == uv.y;
+}
+}  // namespace
+
 void BitmapTexture::prefetch(const SurfaceInteraction &si) const {
+    SurfaceInteraction::TextureMemo &memo = si.texture_memo;
+    if (memo_of(memo, this, si.uv)) return;  // located or read already
     const Lookup l = locate(to_uv_.apply(si.uv));  // both rows of the bilinear footprint (nearest: a subset)
     for (int y : {l.y0, l.y1}) {
         const size_t i = (size_t(y) * width_ + l.x0) * channels_;
         if (!codes_.empty()) __builtin_prefetch(&codes_[i]);
         else __builtin_prefetch(&texels_[i]);
     }
+    memo = {this, si.uv, false, Color(0.f), {l.x0, l.x1, l.y0, l.y1}, {l.wx0, l.wx1, l.wy0, l.wy1}};
 }
 
 Color BitmapTexture::eval(const SurfaceInteraction &si) const {
     SurfaceInteraction::TextureMemo &memo = si.texture_memo;
-    if (memo.texture == this && memo.uv.x == si.uv.x && memo.uv.y == si.uv.y) return memo.value;
+    if (memo_of(memo, this, si.uv)) {
+        if (memo.has_value) return memo.value;
+        if (options_.filter == FilterType::Bilinear) {
+            const Lookup l{memo.texel[0], memo.texel[1], memo.texel[2], memo.texel[3],
+                           memo.weight[0], memo.weight[1], memo.weight[2], memo.weight[3]};
+            memo.value = blend(l);
+            memo.has_value = true;
+            return memo.value;
+        }
+    }
     const Color c = interpolate(to_uv_.apply(si.uv));
-    memo = {this, si.uv, c};
+    memo = {this, si.uv, true, c, {}, {}};
     return c;
 }
 

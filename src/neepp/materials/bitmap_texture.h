@@ -75,6 +75,7 @@ private:
     Lookup locate(Vec2 uv) const;
     Color texel(int x, int y) const;  // already wrapped coordinates
     Color interpolate(Vec2 uv) const;
+    Color blend(const Lookup &l) const;  // bilinear blend of a located footprint
 
     int width_ = 0, height_ = 0, channels_ = 3;
     std::vector<float> texels_;     // float data (HDR images), or empty when codes_ is used
