@@ -89,6 +89,20 @@ struct PathIntegrator::Path {
     // Next event estimation's shadow query, while its ray waits to be traced with the batch's others.
     ShadowQuery shadow;
     ShadowTest test;
+
+    // A new camera path in this slot. Only the state read before it is written is reset: the vertex,
+    // light and shadow-query fields are written at each bounce before any read (and the texture memo in si
+    // is keyed by what it holds), so the slot's ~0.5 KB need not be cleared.
+    void start(const Ray &camera_ray, Sampler *s) {
+        sampler = s;
+        ray = camera_ray;
+        L = Color(0.f);
+        beta = Color(1.f);
+        eta = 1.f;
+        depth = 0;
+        prev_bsdf_pdf = 1.f;
+        prev_delta = true;
+    }
 };
 
 void PathIntegrator::prefetch(const Scene &scene, const Path &path) const { scene.prefetch(path.hit, 1); }
@@ -204,9 +218,7 @@ void PathIntegrator::Li_batch(const Scene &scene, std::span<const Ray> rays, std
     for (size_t base = 0; base < rays.size(); base += kBatch) {
         const size_t n = std::min(kBatch, rays.size() - base);
         for (size_t i = 0; i < n; ++i) {
-            paths[i] = Path{};
-            paths[i].ray = rays[base + i];
-            paths[i].sampler = samplers[base + i];
+            paths[i].start(rays[base + i], samplers[base + i]);
             active[i] = uint32_t(i);
         }
         // Each stage runs over every live path before the next starts, so a prefetch issued for one path
