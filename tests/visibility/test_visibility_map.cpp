@@ -64,7 +64,9 @@ TEST(PairUpdateBuffer, SumsMatchAReferenceMap) {
     PairUpdateBuffer buf;
     std::map<uint64_t, std::pair<uint32_t, uint32_t>> ref;
     PCG32 rng(5, 6);
+    buf.reserve(10);
     for (int i = 0; i < 200000; ++i) {
+        if (i == 1000) buf.reserve(60000);  // re-slots what it holds; nothing lost or doubled
         uint64_t pair = rng.next_u32() % 50000;
         bool vis = rng.next_float() < 0.3f;
         buf.record(pair, vis);

@@ -209,6 +209,9 @@ void NeeppShadowRays::end_pass(const PassStatistics &pass) {
     // Sum every thread's updates per pair first (exact integer sums: independent of how tiles were spread
     // over threads and of the order below), then apply each pair's sum once.
     PairUpdateBuffer merged;
+    size_t entries = 0;
+    for (const ThreadState &ts : threads_) entries += ts.updates.size();
+    merged.reserve(entries);
     std::vector<uint64_t> histogram;
     uint64_t roulettes = 0, paper_q = 0;
     for (ThreadState &ts : threads_) {

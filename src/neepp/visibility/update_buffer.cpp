@@ -24,9 +24,15 @@ void PairUpdateBuffer::add(uint64_t pair, uint32_t visible, uint32_t traced) {
     }
 }
 
-void PairUpdateBuffer::grow() {
+void PairUpdateBuffer::reserve(size_t n) {
+    size_t slots = slots_.empty() ? 1024 : slots_.size();
+    while (2 * n > slots) slots *= 2;  // load factor <= 1/2, as add() keeps it
+    if (slots > slots_.size()) grow(slots);
+}
+
+void PairUpdateBuffer::grow(size_t slots) {
     std::vector<Entry> old = std::move(slots_);
-    slots_.assign(old.empty() ? 1024 : old.size() * 2, Entry{});
+    slots_.assign(slots ? slots : (old.empty() ? 1024 : old.size() * 2), Entry{});
     const uint32_t mask = uint32_t(slots_.size() - 1);
     for (const Entry &e : old) {
         if (!e.key) continue;

@@ -24,10 +24,12 @@ public:
             if (e.key) f(uint64_t(e.key - 1), e.visible, e.traced);
     }
     size_t size() const { return size_; }
+    // Room for n pairs without growing (a merge of several buffers sizes its table once, not by doubling).
+    void reserve(size_t n);
     void clear();
 
 private:
-    void grow();
+    void grow(size_t slots = 0);  // to this many slots (a power of two), or twice as many
     std::vector<Entry> slots_;
     size_t size_ = 0;
 };
