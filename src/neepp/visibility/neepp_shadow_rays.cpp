@@ -72,15 +72,10 @@ const ShadowRayTester &NeeppShadowRays::query_tester() const {
 }
 
 ShadowTest NeeppShadowRays::begin_test(const ShadowQuery &q, Sampler &sampler, RenderCounters &counters) const {
-    // With rejection off, plain NEE from here on: no lookup, no learning (the path integrator then asks
-    // query_tester() instead and does not come here; other callers may). Kept apart from the rest so this
-    // path skips the rest's register saves (callgrind, cornell: ~25 instructions a query).
-    if (phase_ == Phase::Off) return ShadowTest{};
-    return decide(q, sampler, counters);
-}
-
-ShadowTest NeeppShadowRays::decide(const ShadowQuery &q, Sampler &sampler, RenderCounters &counters) const {
     ShadowTest test;  // traced, weight V
+    // With rejection off, plain NEE from here on: no lookup, no learning (the path integrator asks
+    // query_tester() and does not come here then; other callers may).
+    if (phase_ == Phase::Off) return test;
     const auto [a, b] = cells_of(q);
     const uint64_t pair = VisibilityMap::pair_index(a, b);
     ThreadState &ts = threads_.local();

@@ -145,7 +145,6 @@ private:
     // Probe: the first pass, tracing every ray. Then Rejecting, or Off (trace every ray, learn nothing).
     enum class Phase { Probe, Rejecting, Off };
     std::pair<uint32_t, uint32_t> cells_of(const ShadowQuery &q) const;  // (shading voxel, light cell)
-    [[gnu::noinline]] ShadowTest decide(const ShadowQuery &q, Sampler &sampler, RenderCounters &counters) const;
     void calibrate_adaptive(const std::vector<uint64_t> &histogram, uint64_t roulettes, uint64_t paper_q_sum_fixed);
 
     NeeppOptions options_;

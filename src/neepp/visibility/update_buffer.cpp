@@ -10,7 +10,7 @@ inline uint32_t slot_hash(uint32_t key) {
 }  // namespace
 
 void PairUpdateBuffer::add(uint64_t pair, uint32_t visible, uint32_t traced) {
-    if (2 * (size_ + 1) > slots_.size()) grow();  // load factor <= 1/2
+    if (2 * (size_ + 1) > slots_.size()) rehash(slots_.empty() ? 1024 : 2 * slots_.size());  // load factor <= 1/2
     const uint32_t key = uint32_t(pair) + 1, mask = uint32_t(slots_.size() - 1);
     for (uint32_t i = slot_hash(key) & mask;; i = (i + 1) & mask) {
         Entry &e = slots_[i];
@@ -27,12 +27,12 @@ void PairUpdateBuffer::add(uint64_t pair, uint32_t visible, uint32_t traced) {
 void PairUpdateBuffer::reserve(size_t n) {
     size_t slots = slots_.empty() ? 1024 : slots_.size();
     while (2 * n > slots) slots *= 2;  // load factor <= 1/2, as add() keeps it
-    if (slots > slots_.size()) grow(slots);
+    if (slots > slots_.size()) rehash(slots);
 }
 
-void PairUpdateBuffer::grow(size_t slots) {
+void PairUpdateBuffer::rehash(size_t slots) {
     std::vector<Entry> old = std::move(slots_);
-    slots_.assign(slots ? slots : (old.empty() ? 1024 : old.size() * 2), Entry{});
+    slots_.assign(slots, Entry{});
     const uint32_t mask = uint32_t(slots_.size() - 1);
     for (const Entry &e : old) {
         if (!e.key) continue;

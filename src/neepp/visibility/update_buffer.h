@@ -29,7 +29,7 @@ public:
     void clear();
 
 private:
-    void grow(size_t slots = 0);  // to this many slots (a power of two), or twice as many
+    void rehash(size_t slots);  // to this many slots (a power of two, room for what it holds)
     std::vector<Entry> slots_;
     size_t size_ = 0;
 };
