@@ -156,6 +156,25 @@ Shape make_rectangle() {
     return s;
 }
 
+// The same rectangle with texture coordinates that are not affine over it (one corner's uv moved): a
+// point's uv is then the hit triangle's interpolation, which sampling must reproduce triangle by triangle.
+Shape make_rectangle_bent_uv() {
+    Shape s = make_rectangle();
+    s.uvs[3] = Vec2(0.f, 0.5f);
+    s.finalize();
+    return s;
+}
+
+// Two triangles sharing a diagonal, of areas 0.5 and 1.5, that do not form a parallelogram.
+Shape make_kite() {
+    Shape s;
+    s.positions = {{0, 0, 0}, {1, -0.4f, 0}, {2.5f, 0, 0}, {1, 1.2f, 0}};
+    s.uvs = {Vec2(0, 0), Vec2(1, 0), Vec2(1, 1), Vec2(0, 1)};
+    s.indices = {0, 1, 2, 0, 2, 3};
+    s.finalize();
+    return s;
+}
+
 // Coplanar triangles (z = 0) whose areas differ by a factor of 1600, one of them wound to face away
 // (-z), and no texture coordinates. Coplanar and disjoint, they never overlap as seen from a point, so
 // each direction shows at most one point of the light, as the per-point pdf_direction assumes.
@@ -207,6 +226,9 @@ const AreaCase kAreaCases[] = {
     {"rectangle_grazing_along_e1", make_rectangle, Vec3(2.5f, -0.24f, 0.18f)},   // 7 degrees above the plane
     {"rectangle_grazing_along_e2", make_rectangle, Vec3(0.3f, 1.56f, 2.58f)},    // 6 degrees
     {"rectangle_edge_on", make_rectangle, Vec3(2.5f, -0.024f, 0.018f)},  // 0.7 degrees
+    {"rectangle_bent_uv_front", make_rectangle_bent_uv, Vec3(0.2f, -0.45f, 0.45f)},
+    {"kite_front", make_kite, Vec3(1.f, 0.3f, 1.f)},
+    {"kite_grazing", make_kite, Vec3(-1.5f, 0.4f, 0.3f)},
     {"uneven_mesh_front", make_uneven_mesh, Vec3(1.f, 1.f, 1.5f)},
     {"uneven_mesh_grazing", make_uneven_mesh, Vec3(-1.5f, 1.2f, 0.5f)},           // 6 to 18 degrees
     {"uneven_mesh_edge_on", make_uneven_mesh, Vec3(-1.5f, 1.2f, 0.05f)},
@@ -236,6 +258,34 @@ TEST_P(AreaLightSampling, DirectionsFollowPdf) {
 
 INSTANTIATE_TEST_SUITE_P(Lights, AreaLightSampling, ::testing::ValuesIn(kAreaCases),
                          [](const ::testing::TestParamInfo<AreaCase> &info) { return std::string(info.param.name); });
+
+// A parallelogram is sampled as one (no triangle chosen): the point and its uv are affine in u, which
+// the per-triangle mapping is not. With uvs that are not affine over it, a sample that needs its uv takes
+// the triangles' way, and one that does not still the parallelogram's.
+TEST(AreaLight, ParallelogramSamplesAreAffineInU) {
+    auto affine = [](const Shape &shape, bool with_uv) {
+        const PositionSample o = shape.sample_position(Vec2(0.f, 0.f), with_uv),
+                             a = shape.sample_position(Vec2(1.f, 0.f), with_uv),
+                             b = shape.sample_position(Vec2(0.f, 1.f), with_uv);
+        PCG32 rng(5, 2);
+        bool ok = true;
+        for (int k = 0; k < 100; ++k) {
+            const Vec2 u = rng.next_2d();
+            const PositionSample ps = shape.sample_position(u, with_uv);
+            ok &= norm(ps.p - (o.p + (a.p - o.p) * u.x + (b.p - o.p) * u.y)) < 1e-5f;
+            if (with_uv) {
+                const Vec2 uv = o.uv + (a.uv - o.uv) * u.x + (b.uv - o.uv) * u.y;
+                ok &= std::abs(ps.uv.x - uv.x) + std::abs(ps.uv.y - uv.y) < 1e-5f;
+            }
+            EXPECT_NEAR(ps.pdf, 1.f / shape.surface_area(), 1e-6f);
+        }
+        return ok;
+    };
+    EXPECT_TRUE(affine(make_rectangle(), true));
+    EXPECT_TRUE(affine(make_rectangle_bent_uv(), false));
+    EXPECT_FALSE(affine(make_rectangle_bent_uv(), true));
+    EXPECT_FALSE(affine(make_kite(), false));
+}
 
 TEST(AreaLight, UnevenMeshLosesExactlyTheBackFacingArea) {
     // Sanity of the case above: the one back-facing triangle holds 0.4 of the 2.65125 total area.

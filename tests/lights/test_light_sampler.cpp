@@ -47,6 +47,7 @@ void expect_consistent(const LightSampler &sampler, const std::vector<const Ligh
     double sum = 0;
     for (const Light *l : lights) sum += sampler.pmf(kCtx, *l);
     EXPECT_NEAR(sum, 1.0, 1e-6);
+    if (lights.size() < 2) return;  // one light: the frequencies above say all there is to say
 
     const uint64_t n = 200000;
     std::vector<double> observed(lights.size(), 0.0), expected(lights.size());
@@ -83,6 +84,20 @@ TEST(LightSampler, ZeroPowerSceneFallsBackToUniform) {
     auto sampler = make_light_sampler("power", set.lights);
     expect_consistent(*sampler, set.lights);
     for (const Light *l : set.lights) EXPECT_FLOAT_EQ(sampler->pmf(kCtx, *l), 1.f / 3.f);
+}
+
+// One light takes a shortcut (no search): it must still report the pmf that pmf() reads back, 1, also
+// when the light has no power.
+TEST(LightSampler, SingleLightIsConsistent) {
+    for (const Color &intensity : {Color(3.f), Color(0.f)}) {
+        LightSet set({intensity});
+        set.owned[0]->index = 4;  // a light of a larger scene, sampled alone
+        for (const char *name : {"uniform", "power"}) {
+            auto sampler = make_light_sampler(name, set.lights);
+            expect_consistent(*sampler, set.lights);
+            EXPECT_EQ(sampler->pmf(kCtx, *set.lights[0]), 1.f) << name;
+        }
+    }
 }
 
 TEST(LightSampler, MixedLightKinds) {

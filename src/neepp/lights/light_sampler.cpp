@@ -28,7 +28,8 @@ LightDistribution::LightDistribution(const std::vector<const Light *> &lights, c
 
 SampledLight LightDistribution::sample(const std::vector<const Light *> &lights, float u) const {
     if (lights.empty()) return {};
-    const Light *l = lights[distribution_.sample_discrete(u)];
+    // One light (most test scenes): no search, and the pmf is still the one pmf() reads back.
+    const Light *l = lights.size() == 1 ? lights[0] : lights[distribution_.sample_discrete(u)];
     return {l, pmf(*l)};
 }
 

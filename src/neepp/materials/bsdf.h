@@ -75,6 +75,10 @@ public:
     // Cache prefetch of the texture data that evaluating or sampling at si (seen from si.wi) will read.
     // A hint for batched integrators, issued well before shading; it never changes a result.
     virtual void prefetch(const SurfaceInteraction &si) const {}
+    // Whether evaluating or sampling reads si.dpdu / si.dpdv or depends on which way the shading frame's
+    // tangent points (bump maps, anisotropic roughness). When no BSDF of a shape does, its hits get a
+    // shading frame built from the normal alone, without the uv derivatives and the Gram-Schmidt step.
+    virtual bool needs_tangents() const { return false; }
     bool has_flag(uint32_t f) const { return (flags() & f) != 0; }
 };
 

@@ -31,6 +31,7 @@ public:
                       Vec2 u2) const override;
     uint32_t flags() const override { return BSDFGlossyReflection; }
     void prefetch(const SurfaceInteraction &si) const override { prefetch_textures(si, alpha_u_, alpha_v_, eta_, k_, specular_reflectance_); }
+    bool needs_tangents() const override { return alpha_u_ != alpha_v_; }  // anisotropic: aligned with dp/du
 
 private:
     MicrofacetDistribution distribution(const SurfaceInteraction &si) const;

@@ -15,6 +15,7 @@ public:
                       Vec2 u2) const override;
     uint32_t flags() const override { return front_->flags() | back_->flags(); }
     void prefetch(const SurfaceInteraction &si) const override { (si.wi.z >= 0 ? front_ : back_)->prefetch(si); }
+    bool needs_tangents() const override { return front_->needs_tangents() || back_->needs_tangents(); }
 
 private:
     BSDFPtr front_, back_;
@@ -35,6 +36,7 @@ public:
         opacity_->prefetch(si);
         nested_->prefetch(si);
     }
+    bool needs_tangents() const override { return nested_->needs_tangents(); }
 
 private:
     float opacity(const SurfaceInteraction &si) const { return std::clamp(opacity_->eval_1(si), 0.f, 1.f); }
@@ -58,6 +60,7 @@ public:
         height_->prefetch(si);
         nested_->prefetch(si);
     }
+    bool needs_tangents() const override { return true; }  // the height gradient is taken along dp/du, dp/dv
     // The perturbed shading frame, in world space.
     Frame perturbed_frame(const SurfaceInteraction &si) const;
 

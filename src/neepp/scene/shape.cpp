@@ -1,10 +1,14 @@
 #include "neepp/scene/shape.h"
 
+#include <algorithm>
+#include <cmath>
+
 #include "neepp/math/warp.h"
 
 namespace neepp {
 
 void Shape::finalize() {
+    tangents = !bsdf || bsdf->needs_tangents();
     if (kind == Kind::Sphere) {
         area_ = 4.f * kPi * radius * radius;
         return;
@@ -19,6 +23,7 @@ void Shape::finalize() {
     area_ = float(total);
     triangle_distribution_ = Distribution1D(std::move(areas));
     sampling_triangles_.clear();
+    find_parallelogram();
     if (area_light)
         for (size_t i = 0; i < triangle_count(); ++i) sampling_triangles_.push_back(sampling_triangle(i));
 }
@@ -28,6 +33,41 @@ Shape::SamplingTriangle Shape::sampling_triangle(size_t tri) const {
     const Vec3 &p0 = positions[indices[3 * tri]], &p1 = positions[indices[3 * tri + 1]], &p2 = positions[indices[3 * tri + 2]];
     const Vec3 n = normalize(cross(p1 - p0, p2 - p0));
     return {p0, p1 - p0, p2 - p0, flip_normals ? -n : n};
+}
+
+void Shape::find_parallelogram() {
+    is_parallelogram_ = false;
+    if (triangle_count() != 2) return;
+    // The diagonal is the edge the triangles share; the other vertex of each is a corner beside it.
+    const uint32_t *t0 = &indices[0], *t1 = &indices[3];
+    auto in_t1 = [&](uint32_t v) { return v == t1[0] || v == t1[1] || v == t1[2]; };
+    int own0 = -1, shared = 0;
+    for (int k = 0; k < 3; ++k) {
+        if (in_t1(t0[k])) ++shared;
+        else own0 = k;
+    }
+    if (shared != 2 || own0 < 0) return;
+    uint32_t own1 = t1[0];
+    for (int k = 0; k < 3; ++k)
+        if (t1[k] != t0[0] && t1[k] != t0[1] && t1[k] != t0[2]) own1 = t1[k];
+    // Corners in order around the quad: s (a diagonal end), a, the other diagonal end, b.
+    const uint32_t a = t0[own0], s = t0[(own0 + 1) % 3], s2 = t0[(own0 + 2) % 3], b = own1;
+    const Vec3 e1 = positions[a] - positions[s], e2 = positions[b] - positions[s];
+    // A parallelogram's diagonals bisect each other: s + s2 = a + b.
+    const Vec3 gap = positions[s] + positions[s2] - positions[a] - positions[b];
+    const float scale = std::max(norm(e1), norm(e2));
+    if (!(scale > 0) || norm(gap) > 1e-5f * scale) return;
+    const SamplingTriangle f0 = sampling_triangle(0), f1 = sampling_triangle(1);
+    if (!(dot(f0.n, f1.n) > 0.9999f)) return;  // wound inconsistently: keep per-triangle normals
+    Parallelogram &q = parallelogram_;
+    q.p0 = positions[s], q.e1 = e1, q.e2 = e2, q.n = f0.n;
+    q.uv_affine = false;
+    if (!uvs.empty()) {
+        q.uv0 = uvs[s], q.duv1 = uvs[a] - uvs[s], q.duv2 = uvs[b] - uvs[s];
+        const Vec2 uv_gap = uvs[s] + uvs[s2] - uvs[a] - uvs[b];
+        q.uv_affine = std::abs(uv_gap.x) + std::abs(uv_gap.y) <= 1e-6f * (1.f + std::abs(uvs[s].x) + std::abs(uvs[s].y));
+    }
+    is_parallelogram_ = true;
 }
 
 BBox Shape::bounds() const {
@@ -50,6 +90,13 @@ PositionSample Shape::sample_position(Vec2 u, bool with_uv) const {
         ps.n = flip_normals ? -d : d;
         return ps;
     }
+    if (is_parallelogram_ && (!with_uv || parallelogram_.uv_affine)) {
+        const Parallelogram &q = parallelogram_;
+        ps.p = q.p0 + q.e1 * u.x + q.e2 * u.y;
+        ps.n = q.n;
+        if (with_uv) ps.uv = q.uv0 + q.duv1 * u.x + q.duv2 * u.y;
+        return ps;
+    }
     float ux = u.x;
     uint32_t tri = triangle_distribution_.sample_reuse(ux);
     Vec2 b = square_to_uniform_triangle({ux, u.y});
@@ -66,6 +113,15 @@ PositionSample Shape::sample_position(Vec2 u, bool with_uv) const {
         ps.uv = uvs[i0] * (1.f - b.x - b.y) + uvs[i1] * b.x + uvs[i2] * b.y;
     }
     return ps;
+}
+
+Vec3 Shape::shading_normal(uint32_t i0, uint32_t i1, uint32_t i2, float b0, float b1, float b2, const Vec3 &ng) const {
+    if (face_normals || normals.empty()) return ng;
+    Vec3 ns = normals[i0] * b0 + normals[i1] * b1 + normals[i2] * b2;
+    float len2 = squared_norm(ns);
+    if (!(len2 > 0)) return ng;
+    ns = ns / std::sqrt(len2);
+    return flip_normals ? -ns : ns;
 }
 
 void Shape::prefetch(uint32_t prim, int level) const {
@@ -110,6 +166,12 @@ void Shape::fill_interaction(uint32_t prim, float b1, float b2, const Ray &ray, 
     si.n = ng;
     si.p = p0 * b0 + p1 * b1 + p2 * b2;
 
+    if (!tangents) {
+        si.uv = uvs.empty() ? Vec2(b1, b2) : uvs[i0] * b0 + uvs[i1] * b1 + uvs[i2] * b2;
+        si.dpdu = si.dpdv = Vec3(0.f);
+        si.sh_frame = Frame(shading_normal(i0, i1, i2, b0, b1, b2, ng));
+        return;
+    }
     if (!uvs.empty()) {
         Vec2 uv0 = uvs[i0], uv1 = uvs[i1], uv2 = uvs[i2];
         si.uv = uv0 * b0 + uv1 * b1 + uv2 * b2;
@@ -128,13 +190,7 @@ void Shape::fill_interaction(uint32_t prim, float b1, float b2, const Ray &ray, 
         si.dpdu = e1; si.dpdv = e2;
     }
 
-    Vec3 ns = ng;
-    if (!face_normals && !normals.empty()) {
-        ns = normals[i0] * b0 + normals[i1] * b1 + normals[i2] * b2;
-        float len2 = squared_norm(ns);
-        ns = len2 > 0 ? ns / std::sqrt(len2) : ng;
-        if (flip_normals) ns = -ns;
-    }
+    const Vec3 ns = shading_normal(i0, i1, i2, b0, b1, b2, ng);
     // Shading frame aligned with dp/du (Gram-Schmidt), as Mitsuba does, so anisotropic and bump-mapped
     // materials have a consistent tangent.
     Vec3 s = si.dpdu - ns * dot(ns, si.dpdu);

@@ -37,6 +37,10 @@ struct Shape {
 
     BSDFPtr bsdf;
     const Light *area_light = nullptr;  // set when the scene creates an area light for this shape
+    // Hits carry dp/du, dp/dv and a shading frame aligned with dp/du (Mitsuba's), or, when the BSDF reads
+    // neither (BSDF::needs_tangents), a frame built from the normal alone and no derivatives. finalize()
+    // sets it from the BSDF.
+    bool tangents = true;
 
     // Call once after the geometry is final: computes the area and the triangle-area distribution.
     void finalize();
@@ -56,6 +60,8 @@ struct Shape {
     void prefetch(uint32_t prim, int level) const;
 
 private:
+    // The interpolated vertex normal at barycentrics (b0, b1, b2), or the face normal ng (already flipped).
+    Vec3 shading_normal(uint32_t i0, uint32_t i1, uint32_t i2, float b0, float b1, float b2, const Vec3 &ng) const;
     // What sampling a point on one triangle reads: a corner, the two edges from it and the unit face
     // normal (flipped if asked), one 48-byte record instead of three indices, three vertices and a
     // normalization per light sample.
@@ -63,10 +69,22 @@ private:
         Vec3 p0, e1, e2, n;
     };
     SamplingTriangle sampling_triangle(size_t tri) const;
+    // A mesh of two triangles forming a parallelogram (Mitsuba's `rectangle`, a quad from a file) is
+    // sampled as one: p = corner + u.x e1 + u.y e2, with no triangle to choose. Its uv is affine in
+    // (u.x, u.y) when the corners' uvs form a parallelogram too (uv_affine), and then is what a ray hit
+    // at p interpolates.
+    struct Parallelogram {
+        Vec3 p0, e1, e2, n;
+        Vec2 uv0, duv1, duv2;
+        bool uv_affine = false;
+    };
+    void find_parallelogram();
 
     float area_ = 0;
     Distribution1D triangle_distribution_;
     std::vector<SamplingTriangle> sampling_triangles_;  // precomputed for emitters (sampled at every NEE)
+    bool is_parallelogram_ = false;
+    Parallelogram parallelogram_;
 };
 
 }  // namespace neepp

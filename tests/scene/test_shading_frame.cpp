@@ -1,0 +1,85 @@
+// The shading frame a hit gets: aligned with dp/du (Mitsuba's convention) where the shape's BSDF reads
+// tangents (bump maps, anisotropic roughness), built from the normal alone where it does not. Either
+// way it is orthonormal around the same interpolated normal, so isotropic BSDFs give the same values.
+#include <gtest/gtest.h>
+
+#include "neepp/materials/diffuse.h"
+#include "neepp/materials/roughconductor.h"
+#include "neepp/materials/twosided.h"
+#include "neepp/sampling/rng.h"
+#include "neepp/scene/shape.h"
+
+using namespace neepp;
+
+namespace {
+
+// One bent quad with vertex normals and texture coordinates whose u axis is not along an edge.
+Shape make_quad(BSDFPtr bsdf) {
+    Shape s;
+    s.positions = {{0, 0, 0}, {2, 0, 0.3f}, {2, 1.5f, 0.8f}, {0, 1, 0}};
+    s.normals = {normalize(Vec3(0.1f, 0, 1)), normalize(Vec3(-0.2f, 0.1f, 1)), normalize(Vec3(0, -0.3f, 1)),
+                 Vec3(0, 0, 1)};
+    s.uvs = {{0, 0}, {0.7f, 0.7f}, {0, 1.4f}, {-0.5f, 0.5f}};
+    s.indices = {0, 1, 2, 0, 2, 3};
+    s.bsdf = std::move(bsdf);
+    s.finalize();
+    return s;
+}
+
+void expect_orthonormal(const Frame &f) {
+    EXPECT_NEAR(norm(f.s), 1.f, 1e-5f);
+    EXPECT_NEAR(norm(f.t), 1.f, 1e-5f);
+    EXPECT_NEAR(norm(f.n), 1.f, 1e-5f);
+    EXPECT_NEAR(dot(f.s, f.t), 0.f, 1e-5f);
+    EXPECT_NEAR(dot(f.s, f.n), 0.f, 1e-5f);
+    EXPECT_NEAR(norm(cross(f.s, f.t) - f.n), 0.f, 1e-5f);  // right-handed
+}
+
+TEST(ShadingFrame, WhichBsdfsNeedTangents) {
+    auto diffuse = std::make_shared<DiffuseBSDF>(constant_texture(Color(0.5f)));
+    auto bump = std::make_shared<BumpMapBSDF>(constant_texture(0.f), 1.f, diffuse);
+    TexturePtr a = constant_texture(0.2f), b = constant_texture(0.05f);
+    auto isotropic = std::make_shared<RoughConductorBSDF>(MicrofacetType::GGX, a, a, constant_texture(Color(0.2f)),
+                                                          constant_texture(Color(3.f)));
+    auto anisotropic = std::make_shared<RoughConductorBSDF>(MicrofacetType::GGX, a, b, constant_texture(Color(0.2f)),
+                                                            constant_texture(Color(3.f)));
+    EXPECT_FALSE(diffuse->needs_tangents());
+    EXPECT_TRUE(bump->needs_tangents());
+    EXPECT_FALSE(isotropic->needs_tangents());
+    EXPECT_TRUE(anisotropic->needs_tangents());
+    EXPECT_FALSE(TwoSidedBSDF(diffuse, nullptr).needs_tangents());
+    EXPECT_TRUE(TwoSidedBSDF(diffuse, bump).needs_tangents());
+    EXPECT_TRUE(MaskBSDF(constant_texture(0.5f), anisotropic).needs_tangents());
+    EXPECT_FALSE(make_quad(diffuse).tangents);
+    EXPECT_TRUE(make_quad(std::make_shared<TwoSidedBSDF>(bump, nullptr)).tangents);
+}
+
+TEST(ShadingFrame, SameNormalAndUvWithOrWithoutTangents) {
+    auto diffuse = std::make_shared<DiffuseBSDF>(constant_texture(Color(0.5f)));
+    const Shape plain = make_quad(diffuse);
+    const Shape bumped = make_quad(std::make_shared<BumpMapBSDF>(constant_texture(0.f), 1.f, diffuse));
+    ASSERT_FALSE(plain.tangents);
+    ASSERT_TRUE(bumped.tangents);
+    PCG32 rng(11, 3);
+    for (int k = 0; k < 200; ++k) {
+        const uint32_t prim = k % 2;
+        float b1 = rng.next_float(), b2 = rng.next_float();
+        if (b1 + b2 > 1) b1 = 1 - b1, b2 = 1 - b2;
+        const Ray ray{Vec3(1, 0.5f, 3), Vec3(0, 0, -1), 0.f, kInfinity};
+        SurfaceInteraction a, b;
+        plain.fill_interaction(prim, b1, b2, ray, 2.f, a);
+        bumped.fill_interaction(prim, b1, b2, ray, 2.f, b);
+        expect_orthonormal(a.sh_frame);
+        expect_orthonormal(b.sh_frame);
+        EXPECT_NEAR(norm(a.sh_frame.n - b.sh_frame.n), 0.f, 1e-6f);
+        EXPECT_NEAR(norm(a.n - b.n), 0.f, 1e-6f);
+        EXPECT_NEAR(norm(a.p - b.p), 0.f, 1e-6f);
+        EXPECT_NEAR(a.uv.x, b.uv.x, 1e-6f);
+        EXPECT_NEAR(a.uv.y, b.uv.y, 1e-6f);
+        // With tangents: s is dp/du with its normal component removed.
+        const Vec3 s = b.dpdu - b.sh_frame.n * dot(b.sh_frame.n, b.dpdu);
+        EXPECT_NEAR(norm(b.sh_frame.s - normalize(s)), 0.f, 1e-5f);
+    }
+}
+
+}  // namespace
