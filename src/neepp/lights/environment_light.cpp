@@ -86,11 +86,12 @@ Vec2 EnvironmentMapLight::direction_to_uv(const Vec3 &d_world) const {
     return {u, vv};
 }
 
-Vec3 EnvironmentMapLight::uv_to_direction(Vec2 uv) const {
-    float theta = uv.y * kPi, phi = uv.x * 2.f * kPi;
-    float st = std::sin(theta);
-    Vec3 local(st * std::sin(phi), std::cos(theta), -st * std::cos(phi));
-    return normalize(to_world_.vector(local));
+Vec3 EnvironmentMapLight::uv_to_direction(Vec2 uv, float *sin_theta) const {
+    float st, ct, sp, cp;
+    sincosf(uv.y * kPi, &st, &ct);
+    sincosf(uv.x * 2.f * kPi, &sp, &cp);
+    if (sin_theta) *sin_theta = st;
+    return normalize(to_world_.vector(Vec3(st * sp, ct, -st * cp)));
 }
 
 Color EnvironmentMapLight::texel(int x, int y) const {
@@ -107,8 +108,11 @@ Color EnvironmentMapLight::lookup(Vec2 uv) const {
     float x = uv.x * float(w), y = uv.y * float(h - 1);
     int x0 = int(std::floor(x)), y0 = std::clamp(int(std::floor(y)), 0, h - 1);
     float fx = x - float(x0), fy = std::clamp(y - float(y0), 0.f, 1.f);
-    x0 = ((x0 % w) + w) % w;
-    int x1 = (x0 + 1) % w, y1 = std::min(y0 + 1, h - 1);
+    // u in [0, 1] puts x0 in [0, w]: one subtraction wraps it, without the two integer divisions of a
+    // modulo (the general case, for u outside, keeps them).
+    if (x0 == w) x0 = 0;
+    else if (x0 < 0 || x0 > w) x0 = ((x0 % w) + w) % w;
+    int x1 = x0 + 1 == w ? 0 : x0 + 1, y1 = std::min(y0 + 1, h - 1);
     Color c = texel(x0, y0) * ((1 - fx) * (1 - fy)) + texel(x1, y0) * (fx * (1 - fy)) +
               texel(x0, y1) * ((1 - fx) * fy) + texel(x1, y1) * (fx * fy);
     return c;
@@ -147,9 +151,11 @@ DirectionSample EnvironmentMapLight::sample_direction(const Vec3 &ref, Vec2 u, C
     const Vec2 uv = sample_uv(u, pdf_uv);
     DirectionSample ds;
     radiance = Color(0.f);
-    float sin_theta = std::sin(uv.y * kPi);
-    if (pdf_uv <= 0 || sin_theta <= 0) return ds;
-    ds.d = uv_to_direction(uv);
+    if (pdf_uv <= 0) return ds;
+    float sin_theta;
+    const Vec3 d = uv_to_direction(uv, &sin_theta);
+    if (sin_theta <= 0) return ds;
+    ds.d = d;
     ds.pdf = pdf_uv / (2.f * kPi * kPi * sin_theta);
     ds.dist = kInfinity;
     ds.p = ref + ds.d * (4.f * scene_radius_);

@@ -24,7 +24,8 @@ public:
 
     // Map between world directions and the map's (u, v) in [0,1)^2 (v = 0 at the top, the +y pole).
     Vec2 direction_to_uv(const Vec3 &d) const;
-    Vec3 uv_to_direction(Vec2 uv) const;
+    // sin_theta (if given) receives the sine of the polar angle, which the direction's pdf divides by.
+    Vec3 uv_to_direction(Vec2 uv, float *sin_theta = nullptr) const;
 
 private:
     Color lookup(Vec2 uv) const;
