@@ -10,6 +10,7 @@
 #include "neepp/integrators/integrator.h"
 #include "neepp/light_selection/factory.h"
 #include "neepp/loader/scene_loader.h"
+#include "neepp/render/huge_pages.h"
 #include "neepp/render/render_output.h"
 
 #ifndef NEEPP_SCENES_DIR
@@ -178,6 +179,7 @@ void run_demo(const std::string &dir, int spp, bool quiet) {
 }  // namespace
 
 int main(int argc, char **argv) {
+    neepp::restart_with_huge_pages(argv);  // once, before anything is allocated (see huge_pages.h)
     CLI::App app{"neepp: a physically based renderer with Next Event Estimation++"};
     app.require_subcommand(1);
 

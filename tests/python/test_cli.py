@@ -2,6 +2,7 @@
 from __future__ import annotations
 
 import json
+import os
 import signal
 import subprocess
 import time
@@ -30,6 +31,19 @@ def test_render_writes_exr_png_and_stats(neepp_bin, tmp_path):
     assert s["spp"] == 4 and s["width"] == 64 and s["height"] == 36
     assert s["integrator"]["name"] == "path" and s["integrator"]["max_depth"] == 12
     assert s["rays"] >= 4 * 64 * 36 and s["shadow_rays"] > 0
+
+
+@pytest.mark.parametrize("env, expect", [({}, True), ({"NEEPP_NO_HUGE_PAGES": "1"}, False),
+                                         ({"GLIBC_TUNABLES": "glibc.malloc.hugetlb=0"}, False)])
+def test_huge_pages_on_unless_turned_off(neepp_bin, tmp_path, env, expect):
+    # The tool restarts itself with glibc's huge-page tunable (see src/neepp/render/huge_pages.h), unless
+    # asked not to or the user chose the tunable; the statistics say which it ran with.
+    base = {k: v for k, v in os.environ.items() if k not in ("NEEPP_NO_HUGE_PAGES", "GLIBC_TUNABLES")}
+    r = subprocess.run([str(neepp_bin), "render", str(DEMO), "-o", str(tmp_path / "h.exr"), "--spp", "1",
+                        "--stats", str(tmp_path / "s.json"), "--quiet", *SMALL],
+                       capture_output=True, text=True, timeout=120, env={**base, **env})
+    assert r.returncode == 0, r.stderr
+    assert json.loads((tmp_path / "s.json").read_text())["huge_pages"] is expect
 
 
 def test_same_seed_same_image_different_seed_different_image(neepp_bin, tmp_path):

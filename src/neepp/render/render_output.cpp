@@ -3,6 +3,7 @@
 #include <filesystem>
 #include <sys/resource.h>
 #include "neepp/integrators/integrator.h"
+#include "neepp/render/huge_pages.h"
 #include "neepp/scene/scene.h"
 
 namespace neepp {
@@ -39,6 +40,7 @@ nlohmann::json render_statistics(const Scene &scene, const Integrator &integrato
         {"triangles", scene.triangle_count()},
         {"lights", scene.lights().size()},
         {"peak_memory_mb", peak_memory_mb()},
+        {"huge_pages", malloc_huge_pages()},
     };
     if (auto extra = integrator.statistics(); !extra.empty()) j["integrator_statistics"] = extra;
     return j;
