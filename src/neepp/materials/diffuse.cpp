@@ -14,6 +14,12 @@ float DiffuseBSDF::pdf(const BSDFContext &, const SurfaceInteraction &, const Ve
     return square_to_cosine_hemisphere_pdf(wo);
 }
 
+BSDFEval DiffuseBSDF::eval_pdf(const BSDFContext &, const SurfaceInteraction &si, const Vec3 &wi,
+                               const Vec3 &wo) const {
+    if (cos_theta(wi) <= 0 || cos_theta(wo) <= 0) return {};
+    return {reflectance_->eval(si) * (kInvPi * cos_theta(wo)), square_to_cosine_hemisphere_pdf(wo)};
+}
+
 BSDFSample DiffuseBSDF::sample(const BSDFContext &, const SurfaceInteraction &si, const Vec3 &wi, float,
                                Vec2 u2) const {
     BSDFSample bs;
