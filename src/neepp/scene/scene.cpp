@@ -148,10 +148,6 @@ void Scene::trace16(const Ray *const *rays, RayHit *const *hits, int n, bool coh
     }
 }
 
-void Scene::prefetch(const RayHit &hit, int level) const {
-    if (hit.valid()) shapes_[hit.geom]->prefetch(hit.prim, level);
-}
-
 void Scene::fill(const RayHit &hit, const Ray &ray, SurfaceInteraction &si) const {
     shapes_[hit.geom]->fill_interaction(hit.prim, hit.u, hit.v, ray, hit.t, si);
     si.wi = si.to_local(-ray.d);

@@ -54,7 +54,9 @@ public:
     void trace16(const Ray *const *rays, RayHit *const *hits, int n, bool coherent = false) const;
     // Prefetches what fill() will read for hit: level 0 what the hit alone locates (a triangle's
     // indices), level 1 what level 0 brought in locates (its vertex data). A hint: no effect on results.
-    void prefetch(const RayHit &hit, int level) const;
+    void prefetch(const RayHit &hit, int level) const {
+        if (hit.valid()) shapes_[hit.geom]->prefetch(hit.prim, level);
+    }
     void fill(const RayHit &hit, const Ray &ray, SurfaceInteraction &si) const;
     bool occluded(const Ray &ray) const;
     void occluded16(const Ray *const *rays, int n, bool *occluded) const;  // up to 16 rays, one packet

@@ -124,20 +124,6 @@ Vec3 Shape::shading_normal(uint32_t i0, uint32_t i1, uint32_t i2, float b0, floa
     return flip_normals ? -ns : ns;
 }
 
-void Shape::prefetch(uint32_t prim, int level) const {
-    if (kind == Kind::Sphere) return;
-    if (level == 0) {
-        __builtin_prefetch(&indices[3 * prim]);
-        return;
-    }
-    for (int k = 0; k < 3; ++k) {
-        const uint32_t i = indices[3 * prim + k];
-        __builtin_prefetch(&positions[i]);
-        if (!normals.empty()) __builtin_prefetch(&normals[i]);
-        if (!uvs.empty()) __builtin_prefetch(&uvs[i]);
-    }
-}
-
 void Shape::fill_interaction(uint32_t prim, float b1, float b2, const Ray &ray, float t,
                              SurfaceInteraction &si) const {
     si.t = t;

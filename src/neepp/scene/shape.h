@@ -57,7 +57,20 @@ struct Shape {
     void fill_interaction(uint32_t prim, float b1, float b2, const Ray &ray, float t,
                           SurfaceInteraction &si) const;
     // Cache prefetch of what fill_interaction(prim) reads: level 0 the indices, level 1 the vertex data.
-    void prefetch(uint32_t prim, int level) const;
+    // Inline: it runs twice per ray, from the integrator's batch loop.
+    void prefetch(uint32_t prim, int level) const {
+        if (kind == Kind::Sphere) return;
+        if (level == 0) {
+            __builtin_prefetch(&indices[3 * prim]);
+            return;
+        }
+        for (int k = 0; k < 3; ++k) {
+            const uint32_t i = indices[3 * prim + k];
+            __builtin_prefetch(&positions[i]);
+            if (!normals.empty()) __builtin_prefetch(&normals[i]);
+            if (!uvs.empty()) __builtin_prefetch(&uvs[i]);
+        }
+    }
 
 private:
     // The interpolated vertex normal at barycentrics (b0, b1, b2), or the face normal ng (already flipped).
