@@ -115,7 +115,8 @@ std::shared_ptr<BitmapTexture> BitmapTexture::load(const std::string &filename, 
     return std::make_shared<BitmapTexture>(read_image(filename), options);
 }
 
-Color BitmapTexture::texel(int x, int y) const {
+// Always inlined: the bilinear blend fetches four texels per lookup.
+[[gnu::always_inline]] inline Color BitmapTexture::texel(int x, int y) const {
     size_t i = (size_t(y) * width_ + x) * channels_;
     if (!codes_.empty()) {
         const uint8_t *t = &codes_[i];

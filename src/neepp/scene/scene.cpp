@@ -148,11 +148,6 @@ void Scene::trace16(const Ray *const *rays, RayHit *const *hits, int n, bool coh
     }
 }
 
-void Scene::fill(const RayHit &hit, const Ray &ray, SurfaceInteraction &si) const {
-    shapes_[hit.geom]->fill_interaction(hit.prim, hit.u, hit.v, ray, hit.t, si);
-    si.wi = si.to_local(-ray.d);
-}
-
 bool Scene::intersect(const Ray &ray, SurfaceInteraction &si) const {
     const RayHit hit = trace(ray);
     if (!hit.valid()) {

@@ -57,7 +57,10 @@ public:
     void prefetch(const RayHit &hit, int level) const {
         if (hit.valid()) shapes_[hit.geom]->prefetch(hit.prim, level);
     }
-    void fill(const RayHit &hit, const Ray &ray, SurfaceInteraction &si) const;
+    void fill(const RayHit &hit, const Ray &ray, SurfaceInteraction &si) const {
+        shapes_[hit.geom]->fill_interaction(hit.prim, hit.u, hit.v, ray, hit.t, si);
+        si.wi = si.to_local(-ray.d);
+    }
     bool occluded(const Ray &ray) const;
     void occluded16(const Ray *const *rays, int n, bool *occluded) const;  // up to 16 rays, one packet
 

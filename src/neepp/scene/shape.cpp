@@ -127,10 +127,10 @@ Vec3 Shape::shading_normal(uint32_t i0, uint32_t i1, uint32_t i2, float b0, floa
 void Shape::fill_interaction(uint32_t prim, float b1, float b2, const Ray &ray, float t,
                              SurfaceInteraction &si) const {
     si.t = t;
-    si.p = ray.at(t);
     si.shape = this;
     si.prim_index = prim;
     if (kind == Kind::Sphere) {
+        si.p = ray.at(t);
         Vec3 local = normalize(si.p - center);
         si.p = center + local * radius;  // re-project for precision
         si.n = flip_normals ? -local : local;
