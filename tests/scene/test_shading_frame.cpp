@@ -51,6 +51,9 @@ TEST(ShadingFrame, WhichBsdfsNeedTangents) {
     EXPECT_TRUE(TwoSidedBSDF(diffuse, bump).needs_tangents());
     EXPECT_TRUE(MaskBSDF(constant_texture(0.5f), anisotropic).needs_tangents());
     EXPECT_FALSE(make_quad(diffuse).tangents);
+    EXPECT_EQ(make_quad(diffuse).bsdf_flags, uint32_t(BSDFDiffuseReflection));  // what the integrator reads
+    EXPECT_EQ(make_quad(std::make_shared<MaskBSDF>(constant_texture(0.5f), anisotropic)).bsdf_flags,
+              uint32_t(BSDFGlossyReflection | BSDFNull));
     EXPECT_TRUE(make_quad(std::make_shared<TwoSidedBSDF>(bump, nullptr)).tangents);
 }
 

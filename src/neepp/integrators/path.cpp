@@ -138,7 +138,7 @@ bool PathIntegrator::begin_vertex(const Scene &scene, Path &path) const {
     const BSDF &bsdf = *si.shape->bsdf;
     bsdf.prefetch(si);
     path.ctx = light_context(si, ray.d);
-    path.nee = options_.nee && bsdf.has_flag(BSDFSmooth);
+    path.nee = options_.nee && (si.shape->bsdf_flags & BSDFSmooth);
     if (path.nee) {
         path.light = light_sampler_->sample(path.ctx, path.sampler->next_1d());
         path.u_light = path.sampler->next_2d();

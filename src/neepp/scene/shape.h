@@ -41,6 +41,9 @@ struct Shape {
     // neither (BSDF::needs_tangents), a frame built from the normal alone and no derivatives. finalize()
     // sets it from the BSDF.
     bool tangents = true;
+    // bsdf->flags(), read once by finalize(): the path tracer asks at every vertex whether next event
+    // estimation applies, and a wrapper's flags() is two virtual calls deep.
+    uint32_t bsdf_flags = 0;
 
     // Call once after the geometry is final: computes the area and the triangle-area distribution.
     void finalize();
