@@ -24,7 +24,7 @@ void Shape::finalize() {
     area_ = float(total);
     triangle_distribution_ = Distribution1D(std::move(areas));
     sampling_triangles_.clear();
-    find_parallelogram();
+    parallelogram_ = find_parallelogram();
     if (area_light)
         for (size_t i = 0; i < triangle_count(); ++i) sampling_triangles_.push_back(sampling_triangle(i));
 }
@@ -36,9 +36,8 @@ Shape::SamplingTriangle Shape::sampling_triangle(size_t tri) const {
     return {p0, p1 - p0, p2 - p0, flip_normals ? -n : n};
 }
 
-void Shape::find_parallelogram() {
-    is_parallelogram_ = false;
-    if (triangle_count() != 2) return;
+std::optional<Shape::Parallelogram> Shape::find_parallelogram() const {
+    if (triangle_count() != 2) return std::nullopt;
     // The diagonal is the edge the triangles share; the other vertex of each is a corner beside it.
     const uint32_t *t0 = &indices[0], *t1 = &indices[3];
     auto in_t1 = [&](uint32_t v) { return v == t1[0] || v == t1[1] || v == t1[2]; };
@@ -47,7 +46,7 @@ void Shape::find_parallelogram() {
         if (in_t1(t0[k])) ++shared;
         else own0 = k;
     }
-    if (shared != 2 || own0 < 0) return;
+    if (shared != 2 || own0 < 0) return std::nullopt;
     uint32_t own1 = t1[0];
     for (int k = 0; k < 3; ++k)
         if (t1[k] != t0[0] && t1[k] != t0[1] && t1[k] != t0[2]) own1 = t1[k];
@@ -57,18 +56,17 @@ void Shape::find_parallelogram() {
     // A parallelogram's diagonals bisect each other: s + s2 = a + b.
     const Vec3 gap = positions[s] + positions[s2] - positions[a] - positions[b];
     const float scale = std::max(norm(e1), norm(e2));
-    if (!(scale > 0) || norm(gap) > 1e-5f * scale) return;
+    if (!(scale > 0) || norm(gap) > 1e-5f * scale) return std::nullopt;
     const SamplingTriangle f0 = sampling_triangle(0), f1 = sampling_triangle(1);
-    if (!(dot(f0.n, f1.n) > 0.9999f)) return;  // wound inconsistently: keep per-triangle normals
-    Parallelogram &q = parallelogram_;
+    if (!(dot(f0.n, f1.n) > 0.9999f)) return std::nullopt;  // wound inconsistently: keep per-triangle normals
+    Parallelogram q;
     q.p0 = positions[s], q.e1 = e1, q.e2 = e2, q.n = f0.n;
-    q.uv_affine = false;
     if (!uvs.empty()) {
         q.uv0 = uvs[s], q.duv1 = uvs[a] - uvs[s], q.duv2 = uvs[b] - uvs[s];
         const Vec2 uv_gap = uvs[s] + uvs[s2] - uvs[a] - uvs[b];
         q.uv_affine = std::abs(uv_gap.x) + std::abs(uv_gap.y) <= 1e-6f * (1.f + std::abs(uvs[s].x) + std::abs(uvs[s].y));
     }
-    is_parallelogram_ = true;
+    return q;
 }
 
 BBox Shape::bounds() const {
@@ -91,8 +89,8 @@ PositionSample Shape::sample_position(Vec2 u, bool with_uv) const {
         ps.n = flip_normals ? -d : d;
         return ps;
     }
-    if (is_parallelogram_ && (!with_uv || parallelogram_.uv_affine)) {
-        const Parallelogram &q = parallelogram_;
+    if (parallelogram_ && (!with_uv || parallelogram_->uv_affine)) {
+        const Parallelogram &q = *parallelogram_;
         ps.p = q.p0 + q.e1 * u.x + q.e2 * u.y;
         ps.n = q.n;
         if (with_uv) ps.uv = q.uv0 + q.duv1 * u.x + q.duv2 * u.y;

@@ -2,6 +2,7 @@
 // area light it carries if it emits.
 #pragma once
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 #include "neepp/materials/bsdf.h"
@@ -94,13 +95,12 @@ private:
         Vec2 uv0, duv1, duv2;
         bool uv_affine = false;
     };
-    void find_parallelogram();
+    std::optional<Parallelogram> find_parallelogram() const;
 
     float area_ = 0;
     Distribution1D triangle_distribution_;
     std::vector<SamplingTriangle> sampling_triangles_;  // precomputed for emitters (sampled at every NEE)
-    bool is_parallelogram_ = false;
-    Parallelogram parallelogram_;
+    std::optional<Parallelogram> parallelogram_;
 };
 
 }  // namespace neepp
