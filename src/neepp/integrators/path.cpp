@@ -105,8 +105,6 @@ struct PathIntegrator::Path {
     }
 };
 
-void PathIntegrator::prefetch(const Scene &scene, const Path &path) const { scene.prefetch(path.hit, 1); }
-
 bool PathIntegrator::begin_vertex(const Scene &scene, Path &path) const {
     const bool show_emission = path.depth > 0 || !options_.hide_emitters;
     const Ray &ray = path.ray;
@@ -235,9 +233,8 @@ void PathIntegrator::Li_batch(const Scene &scene, std::span<const Ray> rays, std
                 // pixel or a few neighbours: Embree's coherent traversal suits them.
                 scene.trace16(rs, hs, m, paths[active[k0]].depth == 0);
                 counters.rays += m;
-                for (int j = 0; j < m; ++j) scene.prefetch(*hs[j], 0);
+                for (int j = 0; j < m; ++j) scene.prefetch(*hs[j]);
             }
-            for (size_t k = 0; k < live; ++k) prefetch(scene, paths[active[k]]);
             size_t shading = 0;
             for (size_t k = 0; k < live; ++k)
                 if (begin_vertex(scene, paths[active[k]])) active[shading++] = active[k];

@@ -40,7 +40,6 @@ public:
 private:
     struct Path;  // one path's state between stages
     // Stages of one bounce (see Li_batch). begin_vertex and finish_vertex return false when the path ends.
-    void prefetch(const Scene &scene, const Path &path) const;
     bool begin_vertex(const Scene &scene, Path &path) const;
     void prefetch_light(const Path &path) const;
     // Next event estimation at the vertex: begin_direct samples the light chosen at begin_vertex and forms

@@ -24,8 +24,8 @@ struct RenderSettings {
 };
 
 // What Embree reports for a ray before the hit record is filled in. Kept apart so that a batch of paths
-// can trace all its rays first and fill their hit records after the mesh data those need has been
-// prefetched: filling is otherwise a chain of cache misses (indices, then vertices) that stalls the core.
+// can trace all its rays first and fill their hit records after the triangle data those need has been
+// prefetched (Shape::prefetch).
 struct RayHit {
     static constexpr uint32_t kNone = ~0u;
     float t = kInfinity, u = 0, v = 0;
@@ -54,8 +54,8 @@ public:
     void trace16(const Ray *const *rays, RayHit *const *hits, int n, bool coherent = false) const;
     // Prefetches what fill() will read for hit: level 0 what the hit alone locates (a triangle's
     // indices), level 1 what level 0 brought in locates (its vertex data). A hint: no effect on results.
-    void prefetch(const RayHit &hit, int level) const {
-        if (hit.valid()) shapes_[hit.geom]->prefetch(hit.prim, level);
+    void prefetch(const RayHit &hit) const {
+        if (hit.valid()) shapes_[hit.geom]->prefetch(hit.prim);
     }
     void fill(const RayHit &hit, const Ray &ray, SurfaceInteraction &si) const {
         shapes_[hit.geom]->fill_interaction(hit.prim, hit.u, hit.v, ray, hit.t, si);

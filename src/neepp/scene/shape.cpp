@@ -24,6 +24,16 @@ void Shape::finalize() {
     area_ = float(total);
     triangle_distribution_ = Distribution1D(std::move(areas));
     sampling_triangles_.clear();
+    hit_triangles_.resize(triangle_count());
+    for (size_t i = 0; i < hit_triangles_.size(); ++i) {
+        HitTriangle &t = hit_triangles_[i];
+        for (int k = 0; k < 3; ++k) {
+            const uint32_t v = indices[3 * i + k];
+            t.p[k] = positions[v];
+            t.n[k] = normals.empty() ? Vec3() : normals[v];
+            t.uv[k] = uvs.empty() ? Vec2() : uvs[v];
+        }
+    }
     parallelogram_ = find_parallelogram();
     if (area_light)
         for (size_t i = 0; i < triangle_count(); ++i) sampling_triangles_.push_back(sampling_triangle(i));
@@ -117,9 +127,9 @@ PositionSample Shape::sample_position(Vec2 u, bool with_uv) const {
 // Always inlined into fill_interaction (both of its paths; GCC kept it out of line: 1 % of bathroom's
 // instructions). Inlined, its arithmetic may fuse differently with the caller's (FMA), which moves a few
 // paths onto other random decisions: the same image statistically, not to the bit.
-[[gnu::always_inline]] inline Vec3 Shape::shading_normal(uint32_t i0, uint32_t i1, uint32_t i2, float b0, float b1, float b2, const Vec3 &ng) const {
+[[gnu::always_inline]] inline Vec3 Shape::shading_normal(const HitTriangle &tri, float b0, float b1, float b2, const Vec3 &ng) const {
     if (face_normals || normals.empty()) return ng;
-    Vec3 ns = normals[i0] * b0 + normals[i1] * b1 + normals[i2] * b2;
+    Vec3 ns = tri.n[0] * b0 + tri.n[1] * b1 + tri.n[2] * b2;
     float len2 = squared_norm(ns);
     if (!(len2 > 0)) return ng;
     ns = ns / std::sqrt(len2);
@@ -145,8 +155,8 @@ void Shape::fill_interaction(uint32_t prim, float b1, float b2, const Ray &ray, 
         si.sh_frame = Frame(si.n);
         return;
     }
-    uint32_t i0 = indices[3 * prim], i1 = indices[3 * prim + 1], i2 = indices[3 * prim + 2];
-    const Vec3 &p0 = positions[i0], &p1 = positions[i1], &p2 = positions[i2];
+    const HitTriangle &tri = hit_triangles_[prim];
+    const Vec3 &p0 = tri.p[0], &p1 = tri.p[1], &p2 = tri.p[2];
     float b0 = 1.f - b1 - b2;
     Vec3 e1 = p1 - p0, e2 = p2 - p0;
     Vec3 ng = normalize(cross(e1, e2));
@@ -155,13 +165,13 @@ void Shape::fill_interaction(uint32_t prim, float b1, float b2, const Ray &ray, 
     si.p = p0 * b0 + p1 * b1 + p2 * b2;
 
     if (!tangents) {
-        si.uv = uvs.empty() ? Vec2(b1, b2) : uvs[i0] * b0 + uvs[i1] * b1 + uvs[i2] * b2;
+        si.uv = uvs.empty() ? Vec2(b1, b2) : tri.uv[0] * b0 + tri.uv[1] * b1 + tri.uv[2] * b2;
         si.dpdu = si.dpdv = Vec3(0.f);
-        si.sh_frame = Frame(shading_normal(i0, i1, i2, b0, b1, b2, ng));
+        si.sh_frame = Frame(shading_normal(tri, b0, b1, b2, ng));
         return;
     }
     if (!uvs.empty()) {
-        Vec2 uv0 = uvs[i0], uv1 = uvs[i1], uv2 = uvs[i2];
+        Vec2 uv0 = tri.uv[0], uv1 = tri.uv[1], uv2 = tri.uv[2];
         si.uv = uv0 * b0 + uv1 * b1 + uv2 * b2;
         Vec2 du1 = uv1 - uv0, du2 = uv2 - uv0;
         float det = du1.x * du2.y - du1.y * du2.x;
@@ -178,7 +188,7 @@ void Shape::fill_interaction(uint32_t prim, float b1, float b2, const Ray &ray, 
         si.dpdu = e1; si.dpdv = e2;
     }
 
-    const Vec3 ns = shading_normal(i0, i1, i2, b0, b1, b2, ng);
+    const Vec3 ns = shading_normal(tri, b0, b1, b2, ng);
     // Shading frame aligned with dp/du (Gram-Schmidt), as Mitsuba does, so anisotropic and bump-mapped
     // materials have a consistent tangent.
     Vec3 s = si.dpdu - ns * dot(ns, si.dpdu);
