@@ -16,15 +16,34 @@ std::unique_ptr<Scene> demo_scene(int w, int h) {
 
 TEST(RenderLoop, ReachesTheSampleCountInPasses) {
     auto scene = demo_scene(32, 18);
-    auto integ = make_integrator("path", Options(scene->settings.integrator_options));
-    RenderJob job;
-    job.spp = 37;
-    RenderResult r = render(*scene, *integ, job);
-    EXPECT_EQ(r.spp, 37);
-    EXPECT_EQ(r.stopped_by, "spp");
-    EXPECT_GT(r.passes, 3);  // small first passes, so per-pass hooks (NEE++) learn early
-    EXPECT_EQ(r.counters.rays >= uint64_t(37 * 32 * 18), true);
-    EXPECT_GT(pixel_statistics(r.image, 0).mean, 0.0);
+    for (const char *policy : {"nee", "neepp"}) {
+        SCOPED_TRACE(policy);
+        Options options(scene->settings.integrator_options);
+        options.set("shadow_rays", policy);
+        auto integ = make_integrator("path", options);
+        RenderJob job;
+        job.spp = 37;
+        RenderResult r = render(*scene, *integ, job);
+        EXPECT_EQ(r.spp, 37);
+        EXPECT_EQ(r.stopped_by, "spp");
+        if (integ->learns_between_passes())
+            EXPECT_GT(r.passes, 3);  // small first passes, so per-pass hooks (NEE++) learn early
+        else
+            EXPECT_EQ(r.passes, 2);  // else full passes (32 + 5), whose packets of rays start from one pixel
+        EXPECT_EQ(r.counters.rays >= uint64_t(37 * 32 * 18), true);
+        EXPECT_GT(pixel_statistics(r.image, 0).mean, 0.0);
+    }
+}
+
+TEST(RenderLoop, OnlyAnIntegratorWithAVisibilityMapLearnsBetweenPasses) {
+    auto scene = demo_scene(32, 18);
+    auto learns = [&](const OptionMap &o) {
+        auto integ = make_integrator("path", Options(o));
+        integ->prepare(*scene);
+        return integ->learns_between_passes();
+    };
+    EXPECT_FALSE(learns({{"shadow_rays", "nee"}}));
+    EXPECT_TRUE(learns({{"shadow_rays", "neepp"}}));
 }
 
 TEST(RenderLoop, TimeLimitUsesTheBudgetAndStops) {

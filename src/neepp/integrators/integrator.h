@@ -31,6 +31,9 @@ public:
     }
     // Called between passes, single-threaded, after all samples of the pass are in.
     virtual void end_pass(const Scene &scene, const PassStatistics &pass) {}
+    // Whether end_pass changes what later samples do (NEE++ publishes a new map): the render loop then
+    // starts with small passes, so that it learns early. Asked after prepare().
+    virtual bool learns_between_passes() const { return false; }
     // Name and effective options, for the statistics file.
     virtual nlohmann::json describe() const = 0;
     // Extra statistics of this integrator (map size, rays skipped...), merged into the stats file.
