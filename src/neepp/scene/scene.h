@@ -52,8 +52,7 @@ public:
     // similar directions (camera rays of a few neighbouring pixels), so Embree may use its coherent
     // traversal (bathroom, callgrind: -0.8 % instructions; for shadow rays toward lights it cost +1.7 %).
     void trace16(const Ray *const *rays, RayHit *const *hits, int n, bool coherent = false) const;
-    // Prefetches what fill() will read for hit: level 0 what the hit alone locates (a triangle's
-    // indices), level 1 what level 0 brought in locates (its vertex data). A hint: no effect on results.
+    // Prefetches what fill() will read for hit (its triangle's record). A hint: no effect on results.
     void prefetch(const RayHit &hit) const {
         if (hit.valid()) shapes_[hit.geom]->prefetch(hit.prim);
     }
