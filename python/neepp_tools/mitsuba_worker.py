@@ -77,6 +77,10 @@ def main(argv=None) -> int:
         arr = arr[..., :3]
     h, w = arr.shape[:2]
     os.makedirs(os.path.dirname(os.path.abspath(a.out)), exist_ok=True)
+    if a.threads == 1:
+        # Bitmap.write hangs (idle, forever) when Dr.Jit's pool was set to one thread (Mitsuba 3.9.1,
+        # llvm_ad_rgb): the render is timed already, so the pool gets its default size back first.
+        dr.set_thread_count(os.cpu_count() or 2)
     mi.Bitmap(np.ascontiguousarray(arr), mi.Bitmap.PixelFormat.RGB).write(a.out)
 
     ru = resource.getrusage(resource.RUSAGE_SELF)
