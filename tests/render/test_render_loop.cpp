@@ -29,7 +29,7 @@ TEST(RenderLoop, ReachesTheSampleCountInPasses) {
         if (integ->learns_between_passes())
             EXPECT_GT(r.passes, 3);  // small first passes, so per-pass hooks (NEE++) learn early
         else
-            EXPECT_EQ(r.passes, 2);  // else full passes (32 + 5), whose packets of rays start from one pixel
+            EXPECT_EQ(r.passes, 3);  // else 1 spp, then full passes (32 + 4): packets of rays from one pixel
         EXPECT_EQ(r.counters.rays >= uint64_t(37 * 32 * 18), true);
         EXPECT_GT(pixel_statistics(r.image, 0).mean, 0.0);
     }

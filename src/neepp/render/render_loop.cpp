@@ -34,17 +34,17 @@ std::vector<Tile> make_tiles(int width, int height, int size) {
     return tiles;
 }
 
-// Samples per pass. An integrator that learns between passes (NEE++'s map) gets small passes first, so
-// that it learns early, growing geometrically (capped) so per-pass overhead stays negligible. One that does
-// not gets full passes at once: a pixel's samples in a pass are consecutive, so each packet of 16 rays
-// the path tracer traces then starts from one pixel, and coherent rays are cheaper to trace (bathroom
-// 128², 64 spp: passes of 32 give +8.5 % samples/s over passes of 1, +1.7 % over passes of 16). Under a
-// time limit the first pass, whose speed is unknown, is one sample per pixel, and the others are sized to
-// end before the deadline by the speed of the last (with a 5% margin): a pass is all or nothing, so one
-// cut off by the deadline would be work thrown away.
+// Samples per pass. The first is one sample per pixel: a whole image early (what Ctrl-C leaves if it comes
+// soon) and a first measure of the speed. An integrator that learns between passes (NEE++'s map) then
+// gets small passes, so that it learns early, growing geometrically (capped) so per-pass overhead stays
+// negligible. One that does not gets full passes at once: a pixel's samples in a pass are consecutive, so
+// each packet of 16 rays the path tracer traces then starts from one pixel, and coherent rays are cheaper
+// to trace (bathroom 128², 64 spp: passes of 32 give +8.5 % samples/s over passes of 1, +1.7 % over
+// passes of 16). Under a time limit a pass is sized to end before the deadline by the speed of the last
+// (with a 5% margin): a pass is all or nothing, so one cut off by the deadline would be work thrown away.
 int next_pass_size(int done, int target, double seconds_per_spp, double remaining_s, bool timed, bool learns) {
     constexpr int kMaxPass = 32;
-    int size = learns ? std::clamp(done, 1, kMaxPass) : (timed && seconds_per_spp <= 0 ? 1 : kMaxPass);
+    int size = learns || done == 0 ? std::clamp(done, 1, kMaxPass) : kMaxPass;
     if (target > 0) size = std::min(size, target - done);
     if (timed && seconds_per_spp > 0) {
         double affordable = std::floor(0.95 * remaining_s / seconds_per_spp);
