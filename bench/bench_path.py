@@ -4,8 +4,8 @@
 For each scene (default: classroom 640x360, bathroom 512x512; always the reference's resolution and
 max_depth 17) both renderers render at the same spp, interleaved, `--reps` times with seeds 0..reps-1;
 the table gives medians (and the spread) of samples/s, the neepp/Mitsuba ratio, relMSE of each against
-../shared/scenes/<scene>/reference/, and peak memory (neepp: its stats' peak_memory_mb; Mitsuba: the
-worker process's ru_maxrss). bench/out/ (git-ignored) receives results.json, report.md, the EXRs, and
+../shared/scenes/<scene>/reference/, and peak memory (each process's own peak resident set, VmHWM:
+neepp's stats' peak_memory_mb; Mitsuba: the worker's, Python and Mitsuba's libraries included). bench/out/ (git-ignored) receives results.json, report.md, the EXRs, and
 per scene a side-by-side PNG with false-colour relMSE maps.
 
     .venv/bin/python bench/bench_path.py                 # classroom + bathroom, 64 spp, 2 reps
@@ -118,7 +118,7 @@ def main(argv=None) -> int:
                 runs["mitsuba"].append({
                     "seed": rep, "render_time_s": st["render_time_s"], "load_time_s": st["load_time_s"],
                     "wall_s": r.wall_s, "samples_per_s": st["samples_per_s"],
-                    "peak_memory_mb": r.peak_rss_mb, "peak_rss_mb": r.peak_rss_mb,
+                    "peak_memory_mb": st.get("peak_memory_mb", r.peak_rss_mb), "peak_rss_mb": r.peak_rss_mb,
                     **metrics.all_metrics(r.image, ref)})
                 last_img["mitsuba"] = r.image
                 print(f"[{scene}] mitsuba rep {rep}: {st['samples_per_s']:,.0f} samples/s, "

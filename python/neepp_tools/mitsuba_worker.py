@@ -23,6 +23,20 @@ import traceback
 LLVM_DEFAULT = "/usr/lib/x86_64-linux-gnu/libLLVM.so.19.1"
 
 
+def _peak_memory_mb(ru) -> float:
+    """This process's own peak resident set (VmHWM). ru_maxrss is not: Linux folds into it the peak of the
+    address space exec replaced, which for a child started by Python's subprocess (vfork, then exec) is
+    its parent's, so it reported the benchmark script's size rather than Mitsuba's."""
+    try:
+        with open("/proc/self/status") as f:
+            for line in f:
+                if line.startswith("VmHWM:"):
+                    return int(line.split()[1]) / 1024.0
+    except OSError:
+        pass
+    return ru.ru_maxrss / 1024.0
+
+
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser()
     ap.add_argument("--scene", required=True)
@@ -101,7 +115,7 @@ def main(argv=None) -> int:
         "load_time_s": t_load,
         "render_time_s": t_render,  # includes JIT compilation for llvm variants
         "samples_per_s": w * h * a.spp / t_render if t_render > 0 else None,
-        "peak_memory_mb": ru.ru_maxrss / 1024.0,
+        "peak_memory_mb": _peak_memory_mb(ru),
         "cpu_time_s": ru.ru_utime + ru.ru_stime,
     }
     tmp = a.json + ".tmp"

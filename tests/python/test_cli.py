@@ -33,6 +33,21 @@ def test_render_writes_exr_png_and_stats(neepp_bin, tmp_path):
     assert s["rays"] >= 4 * 64 * 36 and s["shadow_rays"] > 0
 
 
+def test_peak_memory_is_the_renders_own(neepp_bin, tmp_path):
+    # A parent holding a lot of memory (here 400 MB, touched) must not show up in the child's peak: Linux
+    # folds the replaced address space's peak into ru_maxrss at exec, and subprocess starts the child from
+    # the parent's (vfork), so a benchmark script's own size used to be reported as neepp's.
+    ballast = bytearray(400 * 1024 * 1024)
+    for i in range(0, len(ballast), 4096):
+        ballast[i] = 1
+    r = run(neepp_bin, "render", DEMO, "-o", tmp_path / "m.exr", "--spp", 1, "--stats", tmp_path / "s.json",
+            "--quiet", *SMALL)
+    assert r.returncode == 0, r.stderr
+    peak = json.loads((tmp_path / "s.json").read_text())["peak_memory_mb"]
+    assert 1 < peak < 300, peak
+    del ballast
+
+
 @pytest.mark.parametrize("env, expect", [({}, True), ({"NEEPP_NO_HUGE_PAGES": "1"}, False),
                                          ({"GLIBC_TUNABLES": "glibc.malloc.hugetlb=0"}, False)])
 def test_huge_pages_on_unless_turned_off(neepp_bin, tmp_path, env, expect):
