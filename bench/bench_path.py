@@ -5,8 +5,9 @@ For each scene (default: classroom 640x360, bathroom 512x512; always the referen
 max_depth 17) both renderers render at the same spp, interleaved, `--reps` times with seeds 0..reps-1;
 the table gives medians (and the spread) of samples/s, the neepp/Mitsuba ratio, relMSE of each against
 ../shared/scenes/<scene>/reference/, and peak memory (each process's own peak resident set, VmHWM:
-neepp's stats' peak_memory_mb; Mitsuba: the worker's, Python and Mitsuba's libraries included). bench/out/ (git-ignored) receives results.json, report.md, the EXRs, and
-per scene a side-by-side PNG with false-colour relMSE maps.
+neepp's stats' peak_memory_mb; Mitsuba: the worker's, Python and Mitsuba's libraries included).
+bench/out/ (git-ignored) receives results.json, report.md, the EXRs, and per scene a side-by-side PNG
+with false-colour relMSE maps.
 
     .venv/bin/python bench/bench_path.py                 # classroom + bathroom, 64 spp, 2 reps
     .venv/bin/python bench/bench_path.py --quick         # 16 spp, 1 rep

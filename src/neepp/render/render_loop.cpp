@@ -44,7 +44,7 @@ std::vector<Tile> make_tiles(int width, int height, int size) {
 // (with a 5% margin): a pass is all or nothing, so one cut off by the deadline would be work thrown away.
 int next_pass_size(int done, int target, double seconds_per_spp, double remaining_s, bool timed, bool learns) {
     constexpr int kMaxPass = 32;
-    int size = learns || done == 0 ? std::clamp(done, 1, kMaxPass) : kMaxPass;
+    int size = done == 0 ? 1 : learns ? std::min(done, kMaxPass) : kMaxPass;
     if (target > 0) size = std::min(size, target - done);
     if (timed && seconds_per_spp > 0) {
         double affordable = std::floor(0.95 * remaining_s / seconds_per_spp);

@@ -46,7 +46,8 @@ struct Shape {
     // estimation applies, and a wrapper's flags() is two virtual calls deep.
     uint32_t bsdf_flags = 0;
 
-    // Call once after the geometry is final: computes the area and the triangle-area distribution.
+    // Call once after the geometry is final: computes the area, the triangle-area distribution and the
+    // per-triangle records that hits (and, for emitters, light samples) read.
     void finalize();
     size_t triangle_count() const { return indices.size() / 3; }
     float surface_area() const { return area_; }
