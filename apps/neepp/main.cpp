@@ -4,6 +4,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iostream>
+#include <stdexcept>
 #include <unistd.h>
 #include <CLI/CLI.hpp>
 #include <fmt/core.h>
@@ -42,6 +43,27 @@ struct RenderArgs {
     bool quiet = false;
 };
 
+// Checks before a render that its files can be written, so that a typing slip costs no render: the
+// folders are created (as `-o out/a.exr` asks), and a folder that cannot be made or written, or an image
+// name that is not .exr (the PNG beside it takes the same name with .png, so `-o a.png` would leave
+// only a PNG), is an error before the scene is even loaded.
+void check_output_path(const std::string &path, const char *what, const char *extension) {
+    namespace fs = std::filesystem;
+    const fs::path file(path);
+    if (extension && file.extension() != extension)
+        throw std::runtime_error(fmt::format("the {} '{}' must end in {}", what, path, extension));
+    if (fs::is_directory(file)) throw std::runtime_error(fmt::format("the {} '{}' is a folder", what, path));
+    const fs::path dir = file.parent_path().empty() ? fs::path(".") : file.parent_path();
+    std::error_code ec;
+    fs::create_directories(dir, ec);
+    if (ec || !fs::is_directory(dir))
+        throw std::runtime_error(fmt::format("cannot create the folder '{}' for the {} '{}': {}", dir.string(), what,
+                                             path, ec ? ec.message() : "a file of that name exists"));
+    if (access(dir.c_str(), W_OK) != 0)
+        throw std::runtime_error(fmt::format("cannot write the {} '{}': the folder '{}' is not writable", what, path,
+                                             dir.string()));
+}
+
 struct Rendered {
     neepp::Image image;
     nlohmann::json stats;
@@ -49,6 +71,8 @@ struct Rendered {
 
 // Loads, renders and writes one image; returns it with its statistics.
 Rendered run_render(const RenderArgs &a) {
+    check_output_path(a.output, "output image", ".exr");
+    if (!a.stats.empty()) check_output_path(a.stats, "statistics file", nullptr);
     std::map<std::string, std::string> defines;
     for (auto &d : a.defines) defines.insert(split_key_value(d, "-D"));
     if (a.spp > 0 && !defines.count("spp")) defines["spp"] = std::to_string(a.spp);
@@ -83,7 +107,11 @@ Rendered run_render(const RenderArgs &a) {
     neepp::RenderResult result = neepp::render(*scene, *integrator, job);
     std::string png = neepp::write_render_images(a.output, result.image);
     nlohmann::json stats = neepp::render_statistics(*scene, *integrator, result, job);
-    if (!a.stats.empty()) std::ofstream(a.stats) << stats.dump(2) << "\n";
+    if (!a.stats.empty()) {
+        std::ofstream out(a.stats);
+        out << stats.dump(2) << "\n";
+        if (!out) throw std::runtime_error(fmt::format("could not write the statistics file '{}'", a.stats));
+    }
     if (!a.quiet)
         fmt::print(stderr, "neepp: {} spp in {:.2f} s ({:.3f} M samples/s, stopped by {}), wrote {} and {}\n", result.spp,
                    result.render_time_s, stats["samples_per_s"].get<double>() * 1e-6, result.stopped_by, a.output, png);

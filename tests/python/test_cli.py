@@ -134,6 +134,32 @@ def test_bad_options_give_a_clear_error(neepp_bin, tmp_path, args, expect):
     assert expect in r.stderr, r.stderr
 
 
+def test_output_folders_are_created(neepp_bin, tmp_path):
+    out = tmp_path / "new" / "folder" / "a.exr"
+    r = run(neepp_bin, "render", DEMO, "-o", out, "--spp", 1, "--stats", tmp_path / "stats" / "s.json", "--quiet",
+            *SMALL, timeout=60)
+    assert r.returncode == 0, r.stderr
+    assert out.is_file() and out.with_suffix(".png").is_file() and (tmp_path / "stats" / "s.json").is_file()
+
+
+@pytest.mark.parametrize("output, stats, expect", [
+    ("a.png", None, "must end in .exr"),               # would have left only a PNG under that name
+    ("blocker/a.exr", None, "cannot create the folder"),
+    ("a.exr", "blocker/s.json", "cannot create the folder"),
+    ("folder.exr", None, "is a folder"),
+])
+def test_unwritable_output_is_refused_before_rendering(neepp_bin, tmp_path, output, stats, expect):
+    (tmp_path / "blocker").write_text("a file where a folder is asked for")
+    (tmp_path / "folder.exr").mkdir()
+    # 10^6 spp: were the check made after rendering, the run would hit the timeout, not fail at once.
+    args = ["render", DEMO, "-o", tmp_path / output, "--spp", 1000000, "--quiet"]
+    if stats:
+        args += ["--stats", tmp_path / stats]
+    r = run(neepp_bin, *args, timeout=30)
+    assert r.returncode == 1, (r.returncode, r.stderr)
+    assert expect in r.stderr, r.stderr
+
+
 def test_demo_writes_its_outputs(neepp_bin, tmp_path):
     r = run(neepp_bin, "demo", "-o", tmp_path / "demo", "--spp", 1, "--quiet", timeout=300)
     assert r.returncode == 0, r.stderr
