@@ -51,6 +51,8 @@ def main(argv=None) -> int:
     ap.add_argument("--integrator", default="path")
     ap.add_argument("--spp-per-pass", type=int, default=0)
     ap.add_argument("--threads", type=int, default=0)
+    ap.add_argument("--define", action="append", default=[], metavar="NAME=VALUE",
+                    help="scene parameter, as mitsuba's -D (repeatable)")
     a = ap.parse_args(argv)
 
     if a.variant.startswith("llvm") and "DRJIT_LIBLLVM_PATH" not in os.environ and os.path.exists(LLVM_DEFAULT):
@@ -66,7 +68,8 @@ def main(argv=None) -> int:
         dr.set_thread_count(a.threads)
     t_import = time.perf_counter() - t0
 
-    params = {"spp": a.spp, "max_depth": a.max_depth, "integrator": a.integrator}
+    params = dict(d.split("=", 1) for d in a.define)
+    params |= {"spp": a.spp, "max_depth": a.max_depth, "integrator": a.integrator}
     if a.resx:
         params["resx"] = a.resx
     if a.resy:

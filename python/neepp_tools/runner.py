@@ -217,15 +217,22 @@ def mitsuba_version() -> str:
 def _cache_key(scene, **kw) -> str:
     scene = Path(scene).resolve()
     st = scene.stat()
-    blob = json.dumps({"scene": str(scene), "size": st.st_size, "mtime": int(st.st_mtime),
-                       "mitsuba": mitsuba_version(), **kw}, sort_keys=True)
+    # A parameter naming a file (a texture, an environment map) counts by its content, which a test may
+    # write anew each run.
+    files = {k: hashlib.sha1(Path(v).read_bytes()).hexdigest() for k, v in (kw.get("defines") or {}).items()
+             if Path(v).is_file()}
+    key = {"scene": str(scene), "size": st.st_size, "mtime": int(st.st_mtime), "mitsuba": mitsuba_version(), **kw}
+    if files:
+        key["files"] = files
+    blob = json.dumps(key, sort_keys=True)
     return hashlib.sha1(blob.encode()).hexdigest()[:16]
 
 
 def run_mitsuba(scene, out_exr=None, *, variant: str = "llvm_ad_rgb", resx: int | None = None,
                 resy: int | None = None, spp: int = 16, max_depth: int = 17, seed: int = 0,
                 integrator: str = "path", spp_per_pass: int = 0, threads: int = 0,
-                timeout: float | None = None, cache: bool | Path = False) -> RenderResult:
+                defines: dict | None = None, timeout: float | None = None,
+                cache: bool | Path = False) -> RenderResult:
     """Render scene with Mitsuba 3 in a child process; returns image + timing stats.
 
     cache=True (or a directory) reuses a previous render with identical parameters, keyed by scene
@@ -233,6 +240,8 @@ def run_mitsuba(scene, out_exr=None, *, variant: str = "llvm_ad_rgb", resx: int 
     """
     kw = dict(variant=variant, resx=resx, resy=resy, spp=int(spp), max_depth=int(max_depth),
               seed=int(seed), integrator=integrator)
+    if defines:  # only when given, so that the keys of existing cached renders stay valid
+        kw["defines"] = {k: str(v) for k, v in defines.items()}
     cache_dir = None
     if cache:
         cache_dir = Path(cache) if not isinstance(cache, bool) else CACHE_DIR
@@ -268,6 +277,8 @@ def run_mitsuba(scene, out_exr=None, *, variant: str = "llvm_ad_rgb", resx: int 
         cmd += ["--spp-per-pass", str(int(spp_per_pass))]
     if threads:
         cmd += ["--threads", str(int(threads))]
+    for k, v in (defines or {}).items():
+        cmd += ["--define", f"{k}={v}"]
     env = dict(os.environ)
     env["PYTHONPATH"] = os.pathsep.join([str(REPO_ROOT / "python")] +
                                         ([env["PYTHONPATH"]] if env.get("PYTHONPATH") else []))
