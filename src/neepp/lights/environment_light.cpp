@@ -30,8 +30,10 @@ EnvironmentMapLight::EnvironmentMapLight(Image image, const Transform &to_world,
     }
     image = Image();  // the texels above are all that is kept
     // Sampling density ∝ luminance × sin(theta) of the row (the equirectangular area element), so the
-    // directional pdf stays bounded near the poles. Each cell's weight uses the bilinear lookups' maximum
-    // neighbourhood by averaging the cell corners, so no cell with radiance gets zero probability.
+    // directional pdf stays bounded near the poles. A texel cell (between four texel centres) weighs the
+    // mean of its corners' luminance: the integral of the bilinear lookup over it, and positive wherever
+    // that lookup is. (The corners' maximum, used before, spread a small sun's weight over the dark cells
+    // around it; no measurable difference on classroom, but the mean is what the cell receives.)
     std::vector<float> weights(size_t(w) * h);
     bool any = false;
     for (int y = 0; y < h; ++y) {
@@ -41,19 +43,20 @@ EnvironmentMapLight::EnvironmentMapLight(Image image, const Transform &to_world,
             for (int dy = 0; dy <= 1; ++dy)
                 for (int dx = 0; dx <= 1; ++dx) {
                     Vec2 uv((float(x) + float(dx)) / float(w), (float(y) + float(dy)) / float(h));
-                    lum = std::max(lum, luminance(lookup(uv)));
+                    lum += std::max(luminance(lookup(uv)), 0.f) * 0.25f;
                 }
-            weights[size_t(y) * w + x] = std::max(lum, 0.f) * sin_theta;
+            weights[size_t(y) * w + x] = lum * sin_theta;
             any |= weights[size_t(y) * w + x] > 0;
         }
     }
     if (!any)  // a black map emits nothing, but sampling it must still be well defined
         for (int y = 0; y < h; ++y)
             for (int x = 0; x < w; ++x) weights[size_t(y) * w + x] = std::sin(kPi * (float(y) + 0.5f) / float(h));
-    // Sample on a grid of at most kMaxSampleWidth x kMaxSampleWidth/2 cells: a table of a few MB stays in
-    // cache, where one per texel of a 2k map (25 MB) made every light sample a cache miss (a fifth of
-    // classroom's time). Each coarse cell sums the texel cells it overlaps, so it is positive wherever
-    // radiance is; within a cell directions are uniform in uv.
+    // Sample on a grid of at most kMaxSampleWidth x kMaxSampleWidth/2 cells: a table of 4 MB, where one per
+    // texel of a 2k map (16 MB) made light samples cache misses. Classroom 320x180 (2k sky with a small
+    // sun), 64 spp, relative variance over 4 seeds: 512 cells 0.1603, 1024 0.1555 (-3 %, same speed),
+    // 2048 0.1548 (-3.4 %, but -5.5 % samples/s). Each coarse cell sums the texel cells it overlaps, so it
+    // is positive wherever radiance is; within a cell directions are uniform in uv.
     sample_w_ = std::min(w, kMaxSampleWidth);
     sample_h_ = std::min(h, kMaxSampleWidth / 2);
     std::vector<float> coarse(size_t(sample_w_) * sample_h_, 0.f);

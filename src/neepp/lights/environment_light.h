@@ -41,8 +41,8 @@ private:
     std::vector<float> float_;
     Transform to_world_;
     float scale_;
-    static constexpr int kMaxSampleWidth = 512;
-    AliasTable cells_;  // sampling cells (texel cells merged down to at most 512x256), ∝ luminance × sin(theta)
+    static constexpr int kMaxSampleWidth = 1024;
+    AliasTable cells_;  // sampling cells (texel cells merged down to at most 1024x512), ∝ luminance × sin(theta)
     int sample_w_ = 0, sample_h_ = 0;
     Color mean_radiance_;
     float scene_radius_ = 1.f;
