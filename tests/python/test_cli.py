@@ -160,6 +160,16 @@ def test_unwritable_output_is_refused_before_rendering(neepp_bin, tmp_path, outp
     assert expect in r.stderr, r.stderr
 
 
+def test_pgo_training_run_renders(neepp_bin, tmp_path):
+    # The profile-guided build's training run (NEEPP_PGO=1 scripts/build.sh) is not part of the default
+    # build, so it is run here with the plain binary: every scene and option it uses must still load.
+    r = subprocess.run(["bash", str(REPO / "scripts" / "pgo_train.sh"), str(neepp_bin), str(tmp_path)],
+                       capture_output=True, text=True, timeout=300)
+    assert r.returncode == 0, r.stderr
+    for name in ("materials", "materials-sobol", "door-ajar-neepp-cv", "office-visibility-bvh", "courtyard"):
+        assert (tmp_path / f"{name}.exr").is_file(), f"{name}.exr missing"
+
+
 def test_demo_writes_its_outputs(neepp_bin, tmp_path):
     r = run(neepp_bin, "demo", "-o", tmp_path / "demo", "--spp", 1, "--quiet", timeout=300)
     assert r.returncode == 0, r.stderr
