@@ -4,8 +4,10 @@
 For each scene (default: classroom 640x360, bathroom 512x512; always the reference's resolution and
 max_depth 17) both renderers render at the same spp, interleaved, `--reps` times with seeds 0..reps-1;
 the table gives medians (and the spread) of samples/s, the neepp/Mitsuba ratio, relMSE of each against
-../shared/scenes/<scene>/reference/, and peak memory (each process's own peak resident set, VmHWM:
-neepp's stats' peak_memory_mb; Mitsuba: the worker's, Python and Mitsuba's libraries included).
+../shared/scenes/<scene>/reference/, the relative variance of each (from pairs of seeds, with 2+ reps:
+relMSE minus relVar is bias² plus the reference's own noise, so a relMSE gap with equal relVar is a
+bias), and peak memory (each process's own peak resident set, VmHWM: neepp's stats' peak_memory_mb;
+Mitsuba: the worker's, Python and Mitsuba's libraries included).
 bench/out/ (git-ignored) receives results.json, report.md, the EXRs, and per scene a side-by-side PNG
 with false-colour relMSE maps.
 
@@ -20,6 +22,7 @@ The machine is shared and noisy: compare ratios from one run only.
 from __future__ import annotations
 
 import argparse
+import itertools
 import json
 import os
 import statistics
@@ -95,6 +98,7 @@ def main(argv=None) -> int:
         ref = exr.read_exr(scenes_dir / scene / "reference" / REFERENCES[scene][3])
         runs = {"neepp": [], "mitsuba": []}
         last_img = {}
+        images = {"neepp": [], "mitsuba": []}
         for rep in range(a.reps):
             if neepp is not None:
                 r = runner.run_neepp(xml, out / f"{scene}_neepp_s{rep}.exr", spp=a.spp, resx=w, resy=h,
@@ -109,6 +113,7 @@ def main(argv=None) -> int:
                     "rays": st.get("rays"), "shadow_rays": st.get("shadow_rays"),
                     **metrics.all_metrics(r.image, ref)})
                 last_img["neepp"] = r.image
+                images["neepp"].append(r.image)
                 print(f"[{scene}] neepp   rep {rep}: {runs['neepp'][-1]['samples_per_s'] or 0:,.0f} samples/s, "
                       f"relMSE {runs['neepp'][-1]['relmse']:.4g}", file=sys.stderr, flush=True)
             if use_mi:
@@ -122,6 +127,7 @@ def main(argv=None) -> int:
                     "peak_memory_mb": st.get("peak_memory_mb", r.peak_rss_mb), "peak_rss_mb": r.peak_rss_mb,
                     **metrics.all_metrics(r.image, ref)})
                 last_img["mitsuba"] = r.image
+                images["mitsuba"].append(r.image)
                 print(f"[{scene}] mitsuba rep {rep}: {st['samples_per_s']:,.0f} samples/s, "
                       f"relMSE {runs['mitsuba'][-1]['relmse']:.4g}", file=sys.stderr, flush=True)
         summ = {}
@@ -131,6 +137,11 @@ def main(argv=None) -> int:
                            ("samples_per_s", "render_time_s", "wall_s", "relmse", "rmse", "mean_abs_rel_error",
                             "mean_ratio", "peak_memory_mb", "shadow_rays", "rays")}
                 summ[k]["samples_per_s_range"] = spread([x.get("samples_per_s") for x in rs])
+                # Relative variance from pairs of seeds: what of relMSE is noise (the rest is bias² plus the
+                # reference's own noise, the same for both renderers).
+                pairs = list(itertools.combinations(images[k], 2))
+                summ[k]["relvar"] = (statistics.fmean(metrics.relative_variance(x, y, ref) for x, y in pairs)
+                                     if pairs else None)
         results["scenes"][scene] = {"width": w, "height": h, "runs": runs, "median": summ}
         n, m = summ.get("neepp", {}), summ.get("mitsuba", {})
         # ratio per repetition (the two renders of a rep ran back to back), then the median
@@ -143,6 +154,7 @@ def main(argv=None) -> int:
                      "mi_sps": msps(m.get("samples_per_s")), "ratio": ratio,
                      "ratio_range": (f"{min(rep_ratios):.3g}-{max(rep_ratios):.3g}" if len(rep_ratios) > 1 else None),
                      "neepp_relmse": n.get("relmse"), "mi_relmse": m.get("relmse"),
+                     "neepp_relvar": n.get("relvar"), "mi_relvar": m.get("relvar"),
                      "neepp_mean": n.get("mean_ratio"), "mi_mean": m.get("mean_ratio"),
                      "neepp_mem": n.get("peak_memory_mb"), "mi_mem": m.get("peak_memory_mb")})
         if last_img:
@@ -155,6 +167,7 @@ def main(argv=None) -> int:
 
     headers = {"scene": "scene", "neepp_sps": "neepp M samples/s", "mi_sps": f"Mitsuba {a.variant} M samples/s",
                "ratio": "ratio neepp/Mitsuba", "ratio_range": "ratio range", "neepp_relmse": "neepp relMSE", "mi_relmse": "Mitsuba relMSE",
+               "neepp_relvar": "neepp relVar", "mi_relvar": "Mitsuba relVar",
                "neepp_mean": "neepp mean/ref", "mi_mean": "Mitsuba mean/ref",
                "neepp_mem": "neepp peak MB", "mi_mem": "Mitsuba peak MB"}
     table = report.markdown_table(rows, list(headers), headers)
