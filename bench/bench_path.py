@@ -97,8 +97,7 @@ def main(argv=None) -> int:
         xml = scenes_dir / scene / "scene.xml"
         ref = exr.read_exr(scenes_dir / scene / "reference" / REFERENCES[scene][3])
         runs = {"neepp": [], "mitsuba": []}
-        last_img = {}
-        images = {"neepp": [], "mitsuba": []}
+        images = {"neepp": [], "mitsuba": []}  # per rep, for relVar and the figures (the last rep's)
         for rep in range(a.reps):
             if neepp is not None:
                 r = runner.run_neepp(xml, out / f"{scene}_neepp_s{rep}.exr", spp=a.spp, resx=w, resy=h,
@@ -112,7 +111,6 @@ def main(argv=None) -> int:
                     "peak_memory_mb": st.get("peak_memory_mb"), "peak_rss_mb": r.peak_rss_mb,
                     "rays": st.get("rays"), "shadow_rays": st.get("shadow_rays"),
                     **metrics.all_metrics(r.image, ref)})
-                last_img["neepp"] = r.image
                 images["neepp"].append(r.image)
                 print(f"[{scene}] neepp   rep {rep}: {runs['neepp'][-1]['samples_per_s'] or 0:,.0f} samples/s, "
                       f"relMSE {runs['neepp'][-1]['relmse']:.4g}", file=sys.stderr, flush=True)
@@ -126,7 +124,6 @@ def main(argv=None) -> int:
                     "wall_s": r.wall_s, "samples_per_s": st["samples_per_s"],
                     "peak_memory_mb": st.get("peak_memory_mb", r.peak_rss_mb), "peak_rss_mb": r.peak_rss_mb,
                     **metrics.all_metrics(r.image, ref)})
-                last_img["mitsuba"] = r.image
                 images["mitsuba"].append(r.image)
                 print(f"[{scene}] mitsuba rep {rep}: {st['samples_per_s']:,.0f} samples/s, "
                       f"relMSE {runs['mitsuba'][-1]['relmse']:.4g}", file=sys.stderr, flush=True)
@@ -157,6 +154,7 @@ def main(argv=None) -> int:
                      "neepp_relvar": n.get("relvar"), "mi_relvar": m.get("relvar"),
                      "neepp_mean": n.get("mean_ratio"), "mi_mean": m.get("mean_ratio"),
                      "neepp_mem": n.get("peak_memory_mb"), "mi_mem": m.get("peak_memory_mb")})
+        last_img = {k: imgs[-1] for k, imgs in images.items() if imgs}
         if last_img:
             report.comparison_figure(out / f"{scene}_compare.png", last_img, ref,
                                      title=f"{scene} {w}x{h}, {a.spp} spp, max_depth {a.max_depth}",

@@ -12,6 +12,7 @@ made procedurally, and so checks every material against Mitsuba as well.
 """
 from __future__ import annotations
 
+import functools
 import re
 from pathlib import Path
 
@@ -41,8 +42,9 @@ def _needs_missing_file(xml: Path, defines: dict) -> str | None:
     return None
 
 
+@functools.cache
 def _defines(scene: str) -> dict:
-    """Scene parameters this test supplies: the materials scene's images, made here (deterministic)."""
+    """Scene parameters this test supplies: the materials scene's images, made here once (deterministic)."""
     if scene != "materials":
         return {}
     from PIL import Image

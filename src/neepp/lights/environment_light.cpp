@@ -32,8 +32,7 @@ EnvironmentMapLight::EnvironmentMapLight(Image image, const Transform &to_world,
     // Sampling density ∝ luminance × sin(theta) of the row (the equirectangular area element), so the
     // directional pdf stays bounded near the poles. A texel cell (between four texel centres) weighs the
     // mean of its corners' luminance: the integral of the bilinear lookup over it, and positive wherever
-    // that lookup is. (The corners' maximum, used before, spread a small sun's weight over the dark cells
-    // around it; no measurable difference on classroom, but the mean is what the cell receives.)
+    // that lookup is.
     std::vector<float> weights(size_t(w) * h);
     bool any = false;
     for (int y = 0; y < h; ++y) {
