@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Create the project's Python virtualenv (.venv, git-ignored) with the tools used by
-# python/neepp_tools, tests/python and bench/: numpy, pytest, matplotlib and Mitsuba 3
+# python/neepp_tools, tests/python and bench/: numpy, pytest, matplotlib, pillow and Mitsuba 3
 # (the peer renderer). Also installs libllvm19 (Debian 12 main) for Mitsuba's llvm_ad_rgb
 # variant, which must then be run with DRJIT_LIBLLVM_PATH set (neepp_tools.runner does it).
 # Idempotent; safe to rerun. Usage: scripts/setup_python.sh [VENV_DIR]
@@ -15,6 +15,7 @@ REQS=(
   "numpy>=1.24,<3"
   "pytest>=7"
   "matplotlib>=3.7"
+  "pillow>=9"
   "mitsuba==3.9.*"
 )
 
@@ -35,20 +36,20 @@ fi
 if "$VENV/bin/python" - "${REQS[@]}" <<'PY' 2>/dev/null
 import sys
 from importlib.metadata import version
-want = {"numpy": None, "pytest": None, "matplotlib": None, "mitsuba": "3.9."}
+want = {"numpy": None, "pytest": None, "matplotlib": None, "pillow": None, "mitsuba": "3.9."}
 for name, prefix in want.items():
     v = version(name)
     if prefix and not v.startswith(prefix):
         sys.exit(1)
 PY
 then
-  echo "setup_python: $VENV already has numpy, pytest, matplotlib, mitsuba 3.9"
+  echo "setup_python: $VENV already has numpy, pytest, matplotlib, pillow, mitsuba 3.9"
 else
   "$VENV/bin/python" -m pip install -q --upgrade pip
   "$VENV/bin/python" -m pip install -q "${REQS[@]}"
 fi
 
-"$VENV/bin/python" -c "import mitsuba, drjit, numpy, matplotlib, pytest; print('setup_python: mitsuba', mitsuba.__version__, 'drjit', drjit.__version__, 'numpy', numpy.__version__)"
+"$VENV/bin/python" -c "import mitsuba, drjit, numpy, matplotlib, PIL, pytest; print('setup_python: mitsuba', mitsuba.__version__, 'drjit', drjit.__version__, 'numpy', numpy.__version__)"
 LLVM=/usr/lib/x86_64-linux-gnu/libLLVM.so.19.1
 if [ -e "$LLVM" ]; then
   echo "setup_python: for llvm_ad_rgb use DRJIT_LIBLLVM_PATH=$LLVM"
