@@ -52,8 +52,11 @@ TEST_P(Furnace, InnerSphereMatchesGeometricSeries) {
         auto out = render_scene_file(path, 64, 7, Options(GetParam().options), "path", GetParam().sampler);
         double expected = expected_furnace(rho, le, max_depth);
         auto st = pixel_statistics(out.image, 1);
-        // max_depth 1 and 2 are deterministic up to float rounding; deeper paths are noisy.
-        double tol = 5 * st.stderr_ + 1e-4 * expected;
+        // max_depth 1 and 2 are deterministic up to float rounding and the ray offset; deeper paths are
+        // noisy. A bounce's rays start ray_epsilon(p) = 2.7e-4 off the sphere (Mitsuba's offset), which
+        // leaves the image 1.1e-4 (max_depth 2) to 1.4e-4 (max_depth 3) low at 65536 spp (3e-5 with an
+        // offset 9x smaller): the allowance covers that.
+        double tol = 5 * st.stderr_ + 3e-4 * expected;
         EXPECT_NEAR(st.mean, expected, tol) << GetParam().name << " max_depth=" << max_depth;
     }
 }

@@ -35,13 +35,7 @@ struct Reservoirs {
 // Shadow ray from surface point x (normal nx, facing the side rendering shades) toward y, stopping just
 // short of it like SurfaceInteraction::spawn_ray_to; or toward direction d when y is at infinity.
 Ray ray_between(const Vec3 &x, const Vec3 &nx, const Vec3 &target, bool infinite) {
-    Vec3 d = infinite ? target : target - x;
-    float eps = ray_epsilon(x);
-    Vec3 o = x + nx * (dot(d, nx) >= 0 ? eps : -eps);
-    if (infinite) return Ray{o, d, 0.f, kInfinity};
-    d = target - o;
-    float dist = norm(d);
-    return Ray{o, d / dist, 0.f, dist * (1.f - 1e-4f)};
+    return infinite ? spawn_ray(x, nx, target) : spawn_ray_to(x, nx, target);
 }
 
 }  // namespace
@@ -73,8 +67,7 @@ SeedingStats seed_visibility_map(const Scene &scene, const VoxelGrid &grid, Visi
                 path_points[i * B + b] = {si.p, n};
                 path_len[i] = uint8_t(b + 1);
                 Vec3 d = Frame(n).to_world(square_to_cosine_hemisphere(rng.next_2d()));
-                float eps = ray_epsilon(si.p);
-                ray = Ray{si.p + n * eps, d, 0.f, kInfinity};
+                ray = spawn_ray(si.p, n, d);
             }
         }
     });
