@@ -165,6 +165,19 @@ Shape make_rectangle_bent_uv() {
     return s;
 }
 
+// The rectangle with vertex normals leaning 60 degrees toward -e1 at one end and +e1 at the other: the side
+// its shading normal faces, which emits, then varies over it (Mitsuba's convention), and a reference point
+// off to one side sees part of the front face dark.
+Shape make_rectangle_bent_normals() {
+    Shape s = make_rectangle();
+    const Vec3 n = normalize(cross(s.positions[1] - s.positions[0], s.positions[2] - s.positions[0]));
+    const Vec3 e1 = normalize(s.positions[1] - s.positions[0]);
+    const Vec3 left = n * 0.5f - e1 * 0.866f, right = n * 0.5f + e1 * 0.866f;
+    s.normals = {left, right, right, left};
+    s.finalize();
+    return s;
+}
+
 // Two triangles sharing a diagonal, of areas 0.5 and 1.5, that do not form a parallelogram.
 Shape make_kite() {
     Shape s;
@@ -227,6 +240,8 @@ const AreaCase kAreaCases[] = {
     {"rectangle_grazing_along_e2", make_rectangle, Vec3(0.3f, 1.56f, 2.58f)},    // 6 degrees
     {"rectangle_edge_on", make_rectangle, Vec3(2.5f, -0.024f, 0.018f)},  // 0.7 degrees
     {"rectangle_bent_uv_front", make_rectangle_bent_uv, Vec3(0.2f, -0.45f, 0.45f)},
+    {"rectangle_bent_normals_front", make_rectangle_bent_normals, Vec3(0.2f, -0.45f, 0.45f)},
+    {"rectangle_bent_normals_aside", make_rectangle_bent_normals, Vec3(2.5f, -0.3f, 0.6f)},
     {"kite_front", make_kite, Vec3(1.f, 0.3f, 1.f)},
     {"kite_grazing", make_kite, Vec3(-1.5f, 0.4f, 0.3f)},
     {"uneven_mesh_front", make_uneven_mesh, Vec3(1.f, 1.f, 1.5f)},
@@ -295,6 +310,27 @@ TEST(AreaLight, UnevenMeshLosesExactlyTheBackFacingArea) {
     const Vec3 ref(1.f, 1.f, 1.5f);
     Chi2Result r = chi2_light(light, ref, trace_area(shape, light), band_below(shape, ref));
     EXPECT_NEAR(r.valid_fraction, 1.0 - 0.4 / 2.65125, 5e-3) << r.describe();
+}
+
+TEST(AreaLight, ShadingNormalDecidesTheSideThatEmits) {
+    // Seen from far along +e1 and a little above, the end of the bent rectangle whose normals lean toward
+    // -e1 faces away, though the face itself is seen from the front: the light shows only its other part.
+    Shape shape = make_rectangle_bent_normals();
+    AreaLight light(&shape, constant_texture(1.f));
+    const Vec3 ref(6.f, -0.3f, 0.4f);
+    int lit = 0, dark = 0;
+    PCG32 rng(9, 1);
+    for (int k = 0; k < 4000; ++k) {
+        Color radiance;
+        const DirectionSample ds = light.sample_direction(ref, rng.next_2d(), radiance);
+        ASSERT_LT(dot(ds.n, ds.d), 0.f) << "the face is seen from its front";
+        const bool emits = dot(ds.ns, ds.d) < 0.f;
+        EXPECT_EQ(emits, ds.pdf > 0.f);
+        EXPECT_EQ(emits, !is_black(radiance));
+        (emits ? lit : dark)++;
+    }
+    EXPECT_GT(lit, 400);
+    EXPECT_GT(dark, 400);
 }
 
 TEST(AreaLight, BackSideIsDark) {

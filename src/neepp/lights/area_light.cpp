@@ -7,14 +7,14 @@ DirectionSample AreaLight::sample_direction(const Vec3 &ref, Vec2 u, Color &radi
     DirectionSample ds;
     ds.p = ps.p;
     ds.n = ps.n;
+    ds.ns = ps.ns;
     Vec3 d = ps.p - ref;
     float dist2 = squared_norm(d);
     ds.dist = std::sqrt(dist2);
     ds.d = d / ds.dist;
-    float cos_light = -dot(ds.n, ds.d);  // one-sided: only the front face emits
     radiance = Color(0.f);
-    if (cos_light <= 0 || !(dist2 > 0)) return ds;
-    ds.pdf = ps.pdf * dist2 / cos_light;
+    if (!emits_toward(ds) || !(dist2 > 0)) return ds;
+    ds.pdf = ps.pdf * dist2 / std::abs(dot(ds.n, ds.d));
     if (constant_) {
         radiance = constant_radiance_;
         return ds;
@@ -26,13 +26,12 @@ DirectionSample AreaLight::sample_direction(const Vec3 &ref, Vec2 u, Color &radi
 }
 
 float AreaLight::pdf_direction(const Vec3 &ref, const DirectionSample &ds) const {
-    float cos_light = -dot(ds.n, ds.d);
-    if (cos_light <= 0) return 0.f;
-    return shape_->pdf_position() * ds.dist * ds.dist / cos_light;
+    if (!emits_toward(ds)) return 0.f;
+    return shape_->pdf_position() * ds.dist * ds.dist / std::abs(dot(ds.n, ds.d));
 }
 
 Color AreaLight::eval_surface(const SurfaceInteraction &si, const Vec3 &w) const {
-    return dot(si.n, w) > 0 ? radiance_->eval(si) : Color(0.f);
+    return dot(si.sh_frame.n, w) > 0 ? radiance_->eval(si) : Color(0.f);
 }
 
 }  // namespace neepp
@@ -48,8 +47,19 @@ std::optional<LightBounds> AreaLight::bounds() const {
         b.normals = DirectionCone::entire_sphere();
         return b;
     }
-    // Union of the face normals, as the emission side is the geometric normal's (flipped if asked).
+    // Union of the face normals and the vertex normals (flipped if asked): the shading normals, which
+    // decide the emission side, lie between a face's vertex normals.
     bool first = true;
+    auto add = [&](const DirectionCone &c) {
+        b.normals = first ? c : cone_union(b.normals, c);
+        first = false;
+    };
+    if (!shape_->face_normals)
+        for (const Vec3 &vn : shape_->normals) {
+            const float len = norm(vn);
+            if (len > 0) add(DirectionCone{(shape_->flip_normals ? -vn : vn) / len, 1.f});
+            if (b.normals.is_entire_sphere()) return b;
+        }
     for (size_t t = 0; t < shape_->triangle_count(); ++t) {
         const Vec3 &p0 = shape_->positions[shape_->indices[3 * t]];
         const Vec3 &p1 = shape_->positions[shape_->indices[3 * t + 1]];
@@ -57,9 +67,7 @@ std::optional<LightBounds> AreaLight::bounds() const {
         Vec3 c = cross(p1 - p0, p2 - p0);
         float len = norm(c);
         if (!(len > 0)) continue;  // degenerate: zero area, never sampled
-        DirectionCone face{(shape_->flip_normals ? -c : c) / len, 1.f};
-        b.normals = first ? face : cone_union(b.normals, face);
-        first = false;
+        add(DirectionCone{(shape_->flip_normals ? -c : c) / len, 1.f});
         if (b.normals.is_entire_sphere()) break;
     }
     return b;

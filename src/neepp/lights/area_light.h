@@ -1,4 +1,6 @@
-// Mitsuba's `area` emitter: uniform radiance from the front side of a shape (the side its normal faces).
+// Mitsuba's `area` emitter: uniform radiance from the front side of a shape. As in Mitsuba, the front is
+// the side its shading normal faces: on a mesh with vertex normals, a point near the silhouette whose
+// interpolated normal has turned away from the viewer does not emit toward it, though its face does.
 #pragma once
 #include "neepp/lights/light.h"
 #include "neepp/materials/texture.h"
@@ -15,11 +17,16 @@ public:
     float pdf_direction(const Vec3 &ref, const DirectionSample &ds) const override;
     Color eval_surface(const SurfaceInteraction &si, const Vec3 &w) const override;
     Color power() const override { return radiance_->mean() * (kPi * shape_->surface_area()); }
-    // The shape's box, a cone around its face normals, one-sided cosine emission.
+    // The shape's box, a cone around its face and vertex normals, one-sided cosine emission.
     std::optional<LightBounds> bounds() const override;
     const Shape *shape() const { return shape_; }
 
 private:
+    // Whether the point of ds emits toward the reference point: it is on the front of its shading
+    // normal, and the direction does not graze its surface (the area-to-solid-angle density, which takes
+    // the geometric normal, would be infinite).
+    static bool emits_toward(const DirectionSample &ds) { return dot(ds.ns, ds.d) < 0.f && dot(ds.n, ds.d) != 0.f; }
+
     const Shape *shape_;
     TexturePtr radiance_;
     // Most emitters are uniform: a light sample then needs neither the point's uv nor a texture lookup.

@@ -13,6 +13,7 @@ namespace neepp {
 struct DirectionSample {
     Vec3 p;              // point on the light (for infinite lights: a point far away along d)
     Vec3 n;              // light surface normal at p (zero for point and infinite lights)
+    Vec3 ns;             // its shading normal, whose front emits (Mitsuba's convention)
     Vec3 d;              // unit direction from the reference point toward the light
     float dist = 0;      // distance to p (infinite for environment lights)
     float pdf = 0;       // solid-angle density at the reference point (1 for delta lights)
@@ -56,6 +57,7 @@ inline DirectionSample direction_sample_from_hit(const Vec3 &ref, const SurfaceI
     DirectionSample ds;
     ds.p = si.p;
     ds.n = si.n;
+    ds.ns = si.sh_frame.n;
     Vec3 d = si.p - ref;
     ds.dist = norm(d);
     ds.d = ds.dist > 0 ? d / ds.dist : Vec3(0, 0, 1);

@@ -69,6 +69,11 @@ std::optional<Shape::Parallelogram> Shape::find_parallelogram() const {
     if (!(scale > 0) || norm(gap) > 1e-5f * scale) return std::nullopt;
     const SamplingTriangle f0 = sampling_triangle(0), f1 = sampling_triangle(1);
     if (!(dot(f0.n, f1.n) > 0.9999f)) return std::nullopt;  // wound inconsistently: keep per-triangle normals
+    // Vertex normals that bend away from the face vary the shading normal, which decides where the
+    // surface emits: sampled per triangle, which interpolates them.
+    if (!face_normals)
+        for (const Vec3 &vn : normals)
+            if (!(dot(flip_normals ? -vn : vn, f0.n) > 0.9999f * norm(vn))) return std::nullopt;
     Parallelogram q;
     q.p0 = positions[s], q.e1 = e1, q.e2 = e2, q.n = f0.n;
     if (!uvs.empty()) {
@@ -96,13 +101,13 @@ PositionSample Shape::sample_position(Vec2 u, bool with_uv) const {
     if (kind == Kind::Sphere) {
         Vec3 d = square_to_uniform_sphere(u);
         ps.p = center + d * radius;
-        ps.n = flip_normals ? -d : d;
+        ps.n = ps.ns = flip_normals ? -d : d;
         return ps;
     }
     if (parallelogram_ && (!with_uv || parallelogram_->uv_affine)) {
         const Parallelogram &q = *parallelogram_;
         ps.p = q.p0 + q.e1 * u.x + q.e2 * u.y;
-        ps.n = q.n;
+        ps.n = ps.ns = q.n;
         if (with_uv) ps.uv = q.uv0 + q.duv1 * u.x + q.duv2 * u.y;
         return ps;
     }
@@ -112,6 +117,7 @@ PositionSample Shape::sample_position(Vec2 u, bool with_uv) const {
     const SamplingTriangle t = sampling_triangle(tri);
     ps.p = t.p0 + t.e1 * b.x + t.e2 * b.y;
     ps.n = t.n;
+    ps.ns = shading_normal(hit_triangles_[tri], 1.f - b.x - b.y, b.x, b.y, t.n);
     // Same uv as a ray hit at this point gets (barycentrics without texture coordinates), so textured
     // emission agrees between light sampling and BSDF sampling.
     if (!with_uv) return ps;

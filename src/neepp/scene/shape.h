@@ -16,6 +16,7 @@ class Light;
 
 struct PositionSample {
     Vec3 p, n;      // point on the surface and its geometric normal
+    Vec3 ns;        // its shading normal (the interpolated vertex normal; n without vertex normals)
     Vec2 uv;
     float pdf = 0;  // area density
 };
