@@ -86,7 +86,12 @@ std::pair<Vec3, float> MicrofacetDistribution::sample(const Vec3 &wi, Vec2 u) co
         float sin_theta = std::sqrt(1.f - cos_theta * cos_theta);
         return {Vec3(cos_phi * sin_theta, sin_phi * sin_theta, cos_theta), pdf};
     }
+    const Vec3 m = sample_normal(wi, u);
+    return {m, eval(m) * smith_g1(wi, m) * absdot(wi, m) / wi.z};
+}
 
+Vec3 MicrofacetDistribution::sample_normal(const Vec3 &wi, Vec2 u) const {
+    if (!sample_visible_) return sample(wi, u).first;  // its density comes with the sample, at no cost
     // Visible normals (Heitz and d'Eon 2014): stretch wi to the alpha = 1 configuration, sample slopes
     // there, rotate back to wi's azimuth and unstretch.
     Vec3 wi_p = normalize(Vec3(alpha_u_ * wi.x, alpha_v_ * wi.y, wi.z));
@@ -99,8 +104,7 @@ std::pair<Vec3, float> MicrofacetDistribution::sample(const Vec3 &wi, Vec2 u) co
     Vec2 slope = sample_visible_11(wi_p.z, u);
     slope = Vec2((cos_phi * slope.x - sin_phi * slope.y) * alpha_u_,
                  (sin_phi * slope.x + cos_phi * slope.y) * alpha_v_);
-    Vec3 m = normalize(Vec3(-slope.x, -slope.y, 1.f));
-    return {m, eval(m) * smith_g1(wi, m) * absdot(wi, m) / wi.z};
+    return normalize(Vec3(-slope.x, -slope.y, 1.f));
 }
 
 Vec2 MicrofacetDistribution::sample_visible_11(float cos_theta_i, Vec2 u) const {
@@ -215,7 +219,7 @@ float integrate_visible_normals(const MicrofacetDistribution &distr, const Vec3 
     for (int j = 0; j < n; ++j)
         for (int i = 0; i < n; ++i) {
             Vec2 node(q.nodes[i] * 0.5f + 0.5f, q.nodes[j] * 0.5f + 0.5f);
-            Vec3 m = distr.sample(wi, node).first;
+            Vec3 m = distr.sample_normal(wi, node);
             // 0.25: the weights are for [-1, 1]^2, the sample square is [0, 1]^2.
             result += term(m) * (q.weights[i] * q.weights[j]) * 0.25f;
         }

@@ -31,6 +31,9 @@ public:
     float pdf(const Vec3 &wi, const Vec3 &m) const;
     // Samples a microfacet normal; returns it with its density pdf(wi, m).
     std::pair<Vec3, float> sample(const Vec3 &wi, Vec2 u) const;
+    // The same normal without its density, for callers that evaluate a mixture's density themselves
+    // (rough plastic, the albedo quadrature): D and G1 are then not computed twice.
+    Vec3 sample_normal(const Vec3 &wi, Vec2 u) const;
     // Smith's separable shadowing-masking G1(wi) G1(wo).
     float G(const Vec3 &wi, const Vec3 &wo, const Vec3 &m) const { return smith_g1(wi, m) * smith_g1(wo, m); }
     float smith_g1(const Vec3 &v, const Vec3 &m) const;

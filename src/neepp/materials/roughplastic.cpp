@@ -73,7 +73,7 @@ BSDFSample RoughPlasticBSDF::sample(const BSDFContext &ctx, const SurfaceInterac
     BSDFSample bs;
     if (wi.z <= 0.f) return bs;
     if (u1 < prob_specular(external_transmittance(wi.z))) {
-        bs.wo = reflect(wi, distr_.sample(wi, u2).first);
+        bs.wo = reflect(wi, distr_.sample_normal(wi, u2));
         bs.sampled_flags = BSDFGlossyReflection;
     } else {
         bs.wo = square_to_cosine_hemisphere(u2);
