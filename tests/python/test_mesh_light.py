@@ -25,7 +25,10 @@ def _ball_obj(path: Path, nu: int = 6, nv: int = 4) -> None:
         verts += [(math.sin(th) * math.cos(2 * math.pi * i / nu), math.sin(th) * math.sin(2 * math.pi * i / nu),
                    math.cos(th)) for i in range(nu)]
     verts.append((0.0, 0.0, -1.0))
-    ring = lambda j, i: 1 + (j - 1) * nu + i % nu  # noqa: E731 (0-based index of ring j, vertex i)
+
+    def ring(j: int, i: int) -> int:  # 0-based index of vertex i of ring j
+        return 1 + (j - 1) * nu + i % nu
+
     faces = [(0, ring(1, i), ring(1, i + 1)) for i in range(nu)]
     for j in range(1, nv - 1):
         for i in range(nu):

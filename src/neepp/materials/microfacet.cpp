@@ -57,41 +57,47 @@ float MicrofacetDistribution::smith_g1(const Vec3 &v, const Vec3 &m) const {
 }
 
 std::pair<Vec3, float> MicrofacetDistribution::sample(const Vec3 &wi, Vec2 u) const {
-    if (!sample_visible_) {
-        // Sample D(m) cos(theta_m): azimuth first (shared by both distributions), then elevation.
-        float sin_phi, cos_phi, alpha_2;
-        if (alpha_u_ == alpha_v_) {
-            float phi = 2.f * kPi * u.y;
-            sin_phi = std::sin(phi);
-            cos_phi = std::cos(phi);
-            alpha_2 = alpha_u_ * alpha_u_;
-        } else {
-            float ratio = alpha_v_ / alpha_u_, tmp = ratio * std::tan(2.f * kPi * u.y);
-            cos_phi = std::copysign(1.f / std::sqrt(tmp * tmp + 1.f), std::abs(u.y - .5f) - .25f);
-            sin_phi = cos_phi * tmp;
-            alpha_2 = 1.f / (sqr(cos_phi / alpha_u_) + sqr(sin_phi / alpha_v_));
-        }
-        float cos_theta, pdf;
-        if (type_ == MicrofacetType::Beckmann) {
-            cos_theta = 1.f / std::sqrt(1.f - alpha_2 * std::log(1.f - u.x));
-            float cos3 = std::max(cos_theta * cos_theta * cos_theta, 1e-20f);
-            pdf = (1.f - u.x) / (kPi * alpha_u_ * alpha_v_ * cos3);
-        } else {
-            float tan_theta_m_2 = alpha_2 * u.x / (1.f - u.x);
-            cos_theta = 1.f / std::sqrt(1.f + tan_theta_m_2);
-            float temp = 1.f + tan_theta_m_2 / alpha_2;
-            float cos3 = std::max(cos_theta * cos_theta * cos_theta, 1e-20f);
-            pdf = 1.f / (kPi * alpha_u_ * alpha_v_ * cos3 * temp * temp);
-        }
-        float sin_theta = std::sqrt(1.f - cos_theta * cos_theta);
-        return {Vec3(cos_phi * sin_theta, sin_phi * sin_theta, cos_theta), pdf};
-    }
-    const Vec3 m = sample_normal(wi, u);
+    if (!sample_visible_) return sample_projected_area(u);
+    const Vec3 m = sample_visible_normal(wi, u);
     return {m, eval(m) * smith_g1(wi, m) * absdot(wi, m) / wi.z};
 }
 
 Vec3 MicrofacetDistribution::sample_normal(const Vec3 &wi, Vec2 u) const {
-    if (!sample_visible_) return sample(wi, u).first;  // its density comes with the sample, at no cost
+    // Without visible normals the density comes with the sample, at no cost.
+    return sample_visible_ ? sample_visible_normal(wi, u) : sample_projected_area(u).first;
+}
+
+std::pair<Vec3, float> MicrofacetDistribution::sample_projected_area(Vec2 u) const {
+    // Sample D(m) cos(theta_m): azimuth first (shared by both distributions), then elevation.
+    float sin_phi, cos_phi, alpha_2;
+    if (alpha_u_ == alpha_v_) {
+        float phi = 2.f * kPi * u.y;
+        sin_phi = std::sin(phi);
+        cos_phi = std::cos(phi);
+        alpha_2 = alpha_u_ * alpha_u_;
+    } else {
+        float ratio = alpha_v_ / alpha_u_, tmp = ratio * std::tan(2.f * kPi * u.y);
+        cos_phi = std::copysign(1.f / std::sqrt(tmp * tmp + 1.f), std::abs(u.y - .5f) - .25f);
+        sin_phi = cos_phi * tmp;
+        alpha_2 = 1.f / (sqr(cos_phi / alpha_u_) + sqr(sin_phi / alpha_v_));
+    }
+    float cos_theta, pdf;
+    if (type_ == MicrofacetType::Beckmann) {
+        cos_theta = 1.f / std::sqrt(1.f - alpha_2 * std::log(1.f - u.x));
+        float cos3 = std::max(cos_theta * cos_theta * cos_theta, 1e-20f);
+        pdf = (1.f - u.x) / (kPi * alpha_u_ * alpha_v_ * cos3);
+    } else {
+        float tan_theta_m_2 = alpha_2 * u.x / (1.f - u.x);
+        cos_theta = 1.f / std::sqrt(1.f + tan_theta_m_2);
+        float temp = 1.f + tan_theta_m_2 / alpha_2;
+        float cos3 = std::max(cos_theta * cos_theta * cos_theta, 1e-20f);
+        pdf = 1.f / (kPi * alpha_u_ * alpha_v_ * cos3 * temp * temp);
+    }
+    float sin_theta = std::sqrt(1.f - cos_theta * cos_theta);
+    return {Vec3(cos_phi * sin_theta, sin_phi * sin_theta, cos_theta), pdf};
+}
+
+Vec3 MicrofacetDistribution::sample_visible_normal(const Vec3 &wi, Vec2 u) const {
     // Visible normals (Heitz and d'Eon 2014): stretch wi to the alpha = 1 configuration, sample slopes
     // there, rotate back to wi's azimuth and unstretch.
     Vec3 wi_p = normalize(Vec3(alpha_u_ * wi.x, alpha_v_ * wi.y, wi.z));

@@ -39,6 +39,9 @@ public:
     float smith_g1(const Vec3 &v, const Vec3 &m) const;
 
 private:
+    // D(m) cos(theta_m) sampled, with its density; visible normals D_wi(m) sampled (density not computed).
+    std::pair<Vec3, float> sample_projected_area(Vec2 u) const;
+    Vec3 sample_visible_normal(const Vec3 &wi, Vec2 u) const;
     Vec2 sample_visible_11(float cos_theta_i, Vec2 u) const;
 
     MicrofacetType type_;
