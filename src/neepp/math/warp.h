@@ -1,5 +1,6 @@
 // Warps from the unit square to common domains, with their densities.
 #pragma once
+#include "neepp/math/trig.h"
 #include "neepp/math/vec.h"
 
 namespace neepp {
@@ -7,10 +8,14 @@ namespace neepp {
 inline Vec2 square_to_uniform_disk_concentric(Vec2 u) {
     float a = 2.f * u.x - 1.f, b = 2.f * u.y - 1.f;
     if (a == 0 && b == 0) return {0, 0};
-    float r, phi;
-    if (std::abs(a) > std::abs(b)) { r = a; phi = (kPi / 4.f) * (b / a); }
-    else { r = b; phi = (kPi / 2.f) - (kPi / 4.f) * (a / b); }
-    return {r * std::cos(phi), r * std::sin(phi)};
+    // The angle is pi/4 * (b/a), or pi/2 - pi/4 * (a/b), whose cosine and sine are the sine and cosine
+    // of pi/4 * (a/b): either way a polynomial on [-pi/4, pi/4] gives them.
+    if (std::abs(a) > std::abs(b)) {
+        const SinCos t = sincos_quarter((kPi / 4.f) * (b / a));
+        return {a * t.cos, a * t.sin};
+    }
+    const SinCos t = sincos_quarter((kPi / 4.f) * (a / b));
+    return {b * t.sin, b * t.cos};
 }
 
 inline Vec3 square_to_cosine_hemisphere(Vec2 u) {

@@ -6,7 +6,7 @@
 namespace neepp {
 
 ReconstructionFilter::ReconstructionFilter(const std::string &type, float radius, float stddev)
-    : radius_(radius), stddev_(stddev) {
+    : radius_(radius), inv_radius_(1.f / radius), stddev_(stddev) {
     if (type == "box") type_ = Type::Box;
     else if (type == "tent") type_ = Type::Tent;
     else if (type == "gaussian") type_ = Type::Gaussian;
@@ -14,16 +14,6 @@ ReconstructionFilter::ReconstructionFilter(const std::string &type, float radius
     if (!(radius > 0) || radius > 16) throw std::invalid_argument("filter radius must be in (0, 16]");
     // Mitsuba's gaussian is shifted so it reaches zero at the radius.
     if (type_ == Type::Gaussian) gauss_offset_ = std::exp(-0.5f * radius_ * radius_ / (stddev_ * stddev_));
-}
-
-float ReconstructionFilter::eval(float x) const {
-    x = std::abs(x);
-    switch (type_) {
-    case Type::Box: return x <= radius_ ? 1.f : 0.f;
-    case Type::Tent: return std::max(0.f, 1.f - x / radius_);
-    case Type::Gaussian: return std::max(0.f, std::exp(-0.5f * x * x / (stddev_ * stddev_)) - gauss_offset_);
-    }
-    return 0.f;
 }
 
 ImageBlock::ImageBlock(int x0, int y0, int width, int height, const ReconstructionFilter *filter)

@@ -1,6 +1,8 @@
 // Film: accumulates filter-weighted radiance samples per pixel, as Mitsuba's hdrfilm does (each sample
 // splats into the pixels within the reconstruction filter's radius; pixel = Σ w·L / Σ w).
 #pragma once
+#include <algorithm>
+#include <cmath>
 #include <string>
 #include <vector>
 #include "neepp/io/image.h"
@@ -13,11 +15,20 @@ public:
     // type: box, tent, gaussian; radius in pixels (box 0.5, tent 1, gaussian 4·stddev by default)
     ReconstructionFilter(const std::string &type, float radius, float stddev);
     float radius() const { return radius_; }
-    float eval(float x) const;  // 1D profile; the 2D filter is separable
+    // 1D profile; the 2D filter is separable. Inline: the film evaluates it for every pixel a sample touches.
+    float eval(float x) const {
+        x = std::abs(x);
+        switch (type_) {
+        case Type::Box: return x <= radius_ ? 1.f : 0.f;
+        case Type::Tent: return std::max(0.f, 1.f - x * inv_radius_);
+        case Type::Gaussian: return std::max(0.f, std::exp(-0.5f * x * x / (stddev_ * stddev_)) - gauss_offset_);
+        }
+        return 0.f;
+    }
 
 private:
     enum class Type { Box, Tent, Gaussian } type_;
-    float radius_, stddev_, gauss_offset_ = 0;
+    float radius_, inv_radius_, stddev_, gauss_offset_ = 0;
 };
 
 // A rectangular block of accumulated samples (a tile plus the filter's border, or the whole image).
