@@ -46,6 +46,26 @@ TEST(RenderLoop, OnlyAnIntegratorWithAVisibilityMapLearnsBetweenPasses) {
     EXPECT_TRUE(learns({{"shadow_rays", "neepp"}}));
 }
 
+TEST(RenderLoop, NeeppWithRejectionOffRendersAsNee) {
+    // Rejection turned off after the first pass (fewer than all of its shadow rays occluded): the policy
+    // then learns nothing, so it gets nee's full passes, and with them nee's image to the bit.
+    auto scene = demo_scene(32, 18);
+    RenderJob job;
+    job.spp = 37;
+    auto nee = make_integrator("path", Options(OptionMap{{"shadow_rays", "nee"}}));
+    const RenderResult a = render(*scene, *nee, job);
+    for (const char *policy : {"neepp", "neepp-adaptive", "neepp-cv"}) {
+        SCOPED_TRACE(policy);
+        auto integ = make_integrator("path", Options(OptionMap{{"shadow_rays", policy}, {"min_occluded", "1"}}));
+        const RenderResult b = render(*scene, *integ, job);
+        EXPECT_FALSE(integ->learns_between_passes());
+        EXPECT_EQ(b.passes, a.passes);
+        EXPECT_EQ(b.passes, 3);
+        ASSERT_EQ(b.image.data.size(), a.image.data.size());
+        EXPECT_TRUE(b.image.data == a.image.data);
+    }
+}
+
 TEST(RenderLoop, TimeLimitUsesTheBudgetAndStops) {
     auto scene = demo_scene(64, 36);
     auto integ = make_integrator("path", Options(scene->settings.integrator_options));

@@ -24,8 +24,8 @@ public:
     explicit PathIntegrator(PathOptions options, std::unique_ptr<ShadowRayTester> shadow);
     void prepare(const Scene &scene) override;
     void end_pass(const Scene &scene, const PassStatistics &pass) override;
-    // A visibility map, kept by prepare() only where a shadow-ray policy or the light sampler reads it.
-    bool learns_between_passes() const override { return shadow_->visibility_map() != nullptr; }
+    // While the shadow-ray policy reads or updates its visibility map (which the light sampler may read too).
+    bool learns_between_passes() const override { return shadow_->learns_between_passes(); }
     nlohmann::json statistics() const override;
     Color Li(const Scene &scene, const Ray &ray, Sampler &sampler, RenderCounters &counters) const override;
     // Paths of a batch advance in lockstep, one bounce at a time and stage by stage, each stage issuing

@@ -112,6 +112,7 @@ public:
 
     // With rejection off (after the first pass), plain NEE: the same answers (trace all, learn nothing).
     const ShadowRayTester &query_tester() const override;
+    bool learns_between_passes() const override { return phase_ != Phase::Off; }
     const VoxelGrid *voxel_grid() const override { return &grid_; }
     const VisibilityMap *visibility_map() const override { return &map_; }
     const NeeppOptions &options() const { return options_; }

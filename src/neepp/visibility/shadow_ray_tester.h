@@ -74,6 +74,11 @@ public:
     // NEE, so such a render costs per query exactly what `nee` does. Read after prepare(scene) and after
     // each end_pass(); valid as long as this tester.
     virtual const ShadowRayTester &query_tester() const { return *this; }
+    // Whether the coming pass reads or updates the map, so that what it learns changes the next pass: the
+    // render loop then keeps passes small early on. False once NEE++ has turned its rejection off (its
+    // queries go to plain NEE and the map stays as it is), so such a render gets the full passes, and the
+    // packets of one pixel's rays, that `nee` gets. Read after prepare(scene) and after each end_pass().
+    virtual bool learns_between_passes() const { return false; }
 };
 
 // Plain next event estimation: every shadow ray is traced.
