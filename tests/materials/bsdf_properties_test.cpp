@@ -164,6 +164,22 @@ TEST(BSDFProperties, RoughPlasticTablesAreSensible) {
     EXPECT_NEAR(p.internal_reflectance(), fresnel_diffuse_reflectance(1 / 1.5f), 0.04f);
 }
 
+TEST(BSDFProperties, RoughPlasticTablesAreSharedOnlyBetweenEqualCoatings) {
+    // The tables are computed once per (distribution, alpha, eta): a second material with the same coating
+    // gets the same tables, one that differs in any of the three gets its own.
+    auto tables = [](MicrofacetType type, float alpha, float ior) {
+        RoughPlasticBSDF p(type, alpha, ior, 1.f, constant_texture(0.5f));
+        std::vector<float> t{p.internal_reflectance()};
+        for (int i = 0; i <= 10; ++i) t.push_back(p.external_transmittance(float(i) / 10.f));
+        return t;
+    };
+    const auto a = tables(MicrofacetType::GGX, 0.3f, 1.5f);
+    EXPECT_EQ(tables(MicrofacetType::GGX, 0.3f, 1.5f), a);
+    EXPECT_NE(tables(MicrofacetType::GGX, 0.31f, 1.5f), a);
+    EXPECT_NE(tables(MicrofacetType::GGX, 0.3f, 1.6f), a);
+    EXPECT_NE(tables(MicrofacetType::Beckmann, 0.3f, 1.5f), a);
+}
+
 TEST(Dielectric, ReflectionPlusTransmissionIsOneAndModesDifferByEta2) {
     DielectricBSDF glass(1.5f, 1.f);
     SurfaceInteraction si;

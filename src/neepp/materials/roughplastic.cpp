@@ -1,5 +1,9 @@
 #include "neepp/materials/roughplastic.h"
 
+#include <map>
+#include <memory>
+#include <mutex>
+#include <tuple>
 #include <tbb/parallel_for.h>
 
 #include "neepp/materials/fresnel.h"
@@ -7,6 +11,54 @@
 #include "neepp/math/warp.h"
 
 namespace neepp {
+
+namespace {
+
+struct CoatingTables {
+    std::array<float, RoughPlasticBSDF::kTransmittanceRes> external_transmittance;
+    float internal_reflectance;
+};
+
+CoatingTables compute_coating_tables(MicrofacetType type, float alpha, float eta) {
+    constexpr int kRes = RoughPlasticBSDF::kTransmittanceRes;
+    // Mitsuba tabulates with visible-normal quadrature whatever sample_visible says.
+    // The entries are independent quadratures: computed in parallel, summed in order afterwards, so the
+    // tables do not depend on the thread count.
+    MicrofacetDistribution visible(type, alpha, true);
+    CoatingTables t;
+    std::array<float, kRes> weighted_reflectance;
+    tbb::parallel_for(0, kRes, [&](int i) {
+        float mu = std::max(1e-6f, float(i) / float(kRes - 1));
+        Vec3 wi(std::sqrt(1.f - mu * mu), 0.f, mu);
+        t.external_transmittance[i] = eval_transmittance(visible, wi, eta);
+        weighted_reflectance[i] = eval_reflectance(visible, wi, 1.f / eta) * mu;
+    });
+    float reflectance_sum = 0.f;
+    for (float r : weighted_reflectance) reflectance_sum += r;
+    // Cosine-weighted hemispherical average: 2 * mean over mu of R(mu) mu.
+    t.internal_reflectance = reflectance_sum / float(kRes) * 2.f;
+    return t;
+}
+
+// The tables depend only on (distribution, alpha, eta), which a scene's rough plastics often share
+// (staircase: 6 materials, 2 distinct; bathroom 5, 3), and each costs as much as loading a large mesh:
+// computed once per process and copied into each BSDF, whose lookups then stay local.
+const CoatingTables &coating_tables(MicrofacetType type, float alpha, float eta) {
+    static std::mutex mutex;
+    static std::map<std::tuple<int, float, float>, std::unique_ptr<const CoatingTables>> memo;
+    const std::tuple<int, float, float> key{int(type), alpha, eta};
+    {
+        std::lock_guard<std::mutex> lock(mutex);
+        if (auto it = memo.find(key); it != memo.end()) return *it->second;
+    }
+    // Computed outside the lock: its parallel loop may run other tasks on this thread meanwhile, one of
+    // which could be another material asking here. Two threads may both compute a key; one result stays.
+    auto tables = std::make_unique<const CoatingTables>(compute_coating_tables(type, alpha, eta));
+    std::lock_guard<std::mutex> lock(mutex);
+    return *memo.try_emplace(key, std::move(tables)).first->second;
+}
+
+}  // namespace
 
 RoughPlasticBSDF::RoughPlasticBSDF(MicrofacetType type, float alpha, float int_ior, float ext_ior,
                                    TexturePtr diffuse_reflectance, TexturePtr specular_reflectance, bool nonlinear,
@@ -16,21 +68,9 @@ RoughPlasticBSDF::RoughPlasticBSDF(MicrofacetType type, float alpha, float int_i
       specular_reflectance_(specular_reflectance ? std::move(specular_reflectance) : constant_texture(1.f)),
       nonlinear_(nonlinear),
       specular_sampling_weight_(specular_sampling_weight(*diffuse_reflectance_, *specular_reflectance_)) {
-    // Mitsuba tabulates with visible-normal quadrature whatever sample_visible says.
-    // The entries are independent quadratures (a fifth of a bathroom's loading time): computed in
-    // parallel, summed in order afterwards, so the tables do not depend on the thread count.
-    MicrofacetDistribution visible(type, alpha, true);
-    std::array<float, kTransmittanceRes> weighted_reflectance;
-    tbb::parallel_for(0, kTransmittanceRes, [&](int i) {
-        float mu = std::max(1e-6f, float(i) / float(kTransmittanceRes - 1));
-        Vec3 wi(std::sqrt(1.f - mu * mu), 0.f, mu);
-        external_transmittance_[i] = eval_transmittance(visible, wi, eta_);
-        weighted_reflectance[i] = eval_reflectance(visible, wi, 1.f / eta_) * mu;
-    });
-    float reflectance_sum = 0.f;
-    for (float r : weighted_reflectance) reflectance_sum += r;
-    // Cosine-weighted hemispherical average: 2 * mean over mu of R(mu) mu.
-    internal_reflectance_ = reflectance_sum / float(kTransmittanceRes) * 2.f;
+    const CoatingTables &t = coating_tables(type, alpha, eta_);
+    external_transmittance_ = t.external_transmittance;
+    internal_reflectance_ = t.internal_reflectance;
 }
 
 float RoughPlasticBSDF::external_transmittance(float cos_theta) const {
