@@ -16,7 +16,8 @@ with false-colour relMSE maps.
     .venv/bin/python bench/bench_path.py --scenes veach-ajar,cornell-box --spp 32 --reps 3
 
 samples/s is pixels*spp / render_time_s as each renderer reports it (neepp: its stats; Mitsuba: the
-mi.render call incl. Dr.Jit's kernel compilation, scene loading excluded); wall_s is the whole process.
+mi.render call incl. Dr.Jit's kernel compilation, scene loading excluded); load s is each renderer's scene
+loading (parsing, meshes, textures, acceleration structure); wall_s is the whole process.
 The machine is shared and noisy: compare ratios from one run only.
 """
 from __future__ import annotations
@@ -106,7 +107,7 @@ def main(argv=None) -> int:
                 st = r.stats
                 rt = st.get("render_time_s")
                 runs["neepp"].append({
-                    "seed": rep, "render_time_s": rt, "wall_s": r.wall_s,
+                    "seed": rep, "render_time_s": rt, "load_time_s": st.get("load_time_s"), "wall_s": r.wall_s,
                     "samples_per_s": st.get("samples_per_s") or (w * h * a.spp / rt if rt else None),
                     "peak_memory_mb": st.get("peak_memory_mb"), "peak_rss_mb": r.peak_rss_mb,
                     "rays": st.get("rays"), "shadow_rays": st.get("shadow_rays"),
@@ -131,7 +132,7 @@ def main(argv=None) -> int:
         for k, rs in runs.items():
             if rs:
                 summ[k] = {m: med([x.get(m) for x in rs]) for m in
-                           ("samples_per_s", "render_time_s", "wall_s", "relmse", "rmse", "mean_abs_rel_error",
+                           ("samples_per_s", "render_time_s", "load_time_s", "wall_s", "relmse", "rmse", "mean_abs_rel_error",
                             "mean_ratio", "peak_memory_mb", "shadow_rays", "rays")}
                 summ[k]["samples_per_s_range"] = spread([x.get("samples_per_s") for x in rs])
                 # Relative variance from pairs of seeds: what of relMSE is noise (the rest is bias² plus the
@@ -153,7 +154,8 @@ def main(argv=None) -> int:
                      "neepp_relmse": n.get("relmse"), "mi_relmse": m.get("relmse"),
                      "neepp_relvar": n.get("relvar"), "mi_relvar": m.get("relvar"),
                      "neepp_mean": n.get("mean_ratio"), "mi_mean": m.get("mean_ratio"),
-                     "neepp_mem": n.get("peak_memory_mb"), "mi_mem": m.get("peak_memory_mb")})
+                     "neepp_mem": n.get("peak_memory_mb"), "mi_mem": m.get("peak_memory_mb"),
+                     "neepp_load": n.get("load_time_s"), "mi_load": m.get("load_time_s")})
         last_img = {k: imgs[-1] for k, imgs in images.items() if imgs}
         if last_img:
             report.comparison_figure(out / f"{scene}_compare.png", last_img, ref,
@@ -167,7 +169,8 @@ def main(argv=None) -> int:
                "ratio": "ratio neepp/Mitsuba", "ratio_range": "ratio range", "neepp_relmse": "neepp relMSE", "mi_relmse": "Mitsuba relMSE",
                "neepp_relvar": "neepp relVar", "mi_relvar": "Mitsuba relVar",
                "neepp_mean": "neepp mean/ref", "mi_mean": "Mitsuba mean/ref",
-               "neepp_mem": "neepp peak MB", "mi_mem": "Mitsuba peak MB"}
+               "neepp_mem": "neepp peak MB", "mi_mem": "Mitsuba peak MB",
+               "neepp_load": "neepp load s", "mi_load": "Mitsuba load s"}
     table = report.markdown_table(rows, list(headers), headers)
     credits = "".join(f"\n- {scene}: {credit(scene)}" for scene in scenes if credit(scene))
     if credits:

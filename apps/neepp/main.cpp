@@ -1,5 +1,6 @@
 // The `neepp` command-line tool: render a Mitsuba 3 scene, or the built-in demo.
 #include <atomic>
+#include <chrono>
 #include <csignal>
 #include <filesystem>
 #include <fstream>
@@ -76,7 +77,10 @@ Rendered run_render(const RenderArgs &a) {
     std::map<std::string, std::string> defines;
     for (auto &d : a.defines) defines.insert(split_key_value(d, "-D"));
     if (a.spp > 0 && !defines.count("spp")) defines["spp"] = std::to_string(a.spp);
+    // Loading (parsing, meshes, textures, the BVH) is timed apart from rendering, as Mitsuba's load is.
+    const auto load_start = std::chrono::steady_clock::now();
     auto scene = neepp::load_scene(a.scene, defines);
+    const double load_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - load_start).count();
     if (!a.rfilter.empty()) {  // e.g. box, so a low-resolution render matches a box-downsampled reference
         scene->settings.rfilter = a.rfilter;
         scene->settings.rfilter_radius = a.rfilter == "box" ? 0.5f : a.rfilter == "tent" ? 1.f : 4.f * scene->settings.rfilter_stddev;
@@ -100,13 +104,15 @@ Rendered run_render(const RenderArgs &a) {
     job.progress = !a.quiet && isatty(STDERR_FILENO);
     job.cancel = &g_cancel;
     if (!a.quiet)
-        fmt::print(stderr, "neepp: {} ({}x{}, {} triangles, {} lights), integrator {}, {}\n", a.scene,
-                   scene->camera.width, scene->camera.height, scene->triangle_count(), scene->lights().size(), name,
+        fmt::print(stderr, "neepp: {} ({}x{}, {} triangles, {} lights, loaded in {:.2f} s), integrator {}, {}\n",
+                   a.scene, scene->camera.width, scene->camera.height, scene->triangle_count(), scene->lights().size(),
+                   load_s, name,
                    job.spp > 0 ? fmt::format("{} spp", job.spp) : fmt::format("{} s", job.time_limit_s));
 
     neepp::RenderResult result = neepp::render(*scene, *integrator, job);
     std::string png = neepp::write_render_images(a.output, result.image);
     nlohmann::json stats = neepp::render_statistics(*scene, *integrator, result, job);
+    stats["load_time_s"] = load_s;
     if (!a.stats.empty()) {
         std::ofstream out(a.stats);
         out << stats.dump(2) << "\n";
