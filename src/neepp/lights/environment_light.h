@@ -31,7 +31,15 @@ private:
     Color lookup(Vec2 uv) const;
     // The map point sample_direction(u) picks and its density in uv (0 where nothing can be sampled).
     Vec2 sample_uv(Vec2 u, float &pdf_uv) const;
-    Color texel(int x, int y) const;
+    // Texel (x, y) at index y * width + x.
+    Color texel(size_t index) const;
+    Color texel(int x, int y) const { return texel(size_t(y) * width_ + x); }
+    // lookup(uv)'s four texels (wrapping in u, clamped in v) and their weights.
+    struct Bilinear {
+        size_t i00, i10, i01, i11;
+        float w00, w10, w01, w11;
+    };
+    Bilinear bilinear(Vec2 uv) const;
     // Texels as half floats (RGB, 6 bytes): a 2k map is 12.6 MB instead of 25 MB, so with the sampling
     // table it stays in the last-level cache, where float texels made every sampled direction a miss to
     // memory (8-11 % of classroom's render time). Half keeps 11 significant bits, below the noise of any
