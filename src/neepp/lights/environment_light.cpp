@@ -34,29 +34,32 @@ EnvironmentMapLight::EnvironmentMapLight(Image image, const Transform &to_world,
     // mean of its corners' luminance: the integral of the bilinear lookup over it, and positive wherever
     // that lookup is.
     // Luminance is linear in RGB, so that of the bilinear lookup is the bilinear blend of the texels'
-    // luminances: blended from one float per texel, and once per cell corner (corners are shared by four
-    // cells), instead of four RGB lookups of four half texels per cell (a fifth of classroom's loading).
+    // luminances: blended from one float per texel, and once per cell corner (a corner row serves the
+    // cells above and below it), instead of four RGB lookups of four half texels per cell (a fifth of
+    // classroom's loading).
     std::vector<float> texel_lum(size_t(w) * h);
     for (int y = 0; y < h; ++y)
         for (int x = 0; x < w; ++x) texel_lum[size_t(y) * w + x] = luminance(texel(x, y));
-    std::vector<float> corner_lum(size_t(w + 1) * (h + 1));
-    for (int y = 0; y <= h; ++y)
+    auto corner_row = [&](int y, std::vector<float> &row) {
         for (int x = 0; x <= w; ++x) {
             const Bilinear b = bilinear(Vec2(float(x) / float(w), float(y) / float(h)));
             const float l = texel_lum[b.i00] * b.w00 + texel_lum[b.i10] * b.w10 + texel_lum[b.i01] * b.w01 +
                             texel_lum[b.i11] * b.w11;
-            corner_lum[size_t(y) * (w + 1) + x] = std::max(l, 0.f);
+            row[x] = std::max(l, 0.f);
         }
-    std::vector<float> weights(size_t(w) * h);
+    };
+    std::vector<float> weights(size_t(w) * h), c0(w + 1), c1(w + 1);
+    corner_row(0, c0);
     bool any = false;
     for (int y = 0; y < h; ++y) {
         float sin_theta = std::sin(kPi * (float(y) + 0.5f) / float(h));
-        const float *c0 = &corner_lum[size_t(y) * (w + 1)], *c1 = c0 + (w + 1);
+        corner_row(y + 1, c1);
         for (int x = 0; x < w; ++x) {
             const float lum = (c0[x] + c0[x + 1] + c1[x] + c1[x + 1]) * 0.25f;
             weights[size_t(y) * w + x] = lum * sin_theta;
             any |= weights[size_t(y) * w + x] > 0;
         }
+        std::swap(c0, c1);
     }
     if (!any)  // a black map emits nothing, but sampling it must still be well defined
         for (int y = 0; y < h; ++y)
