@@ -156,6 +156,42 @@ TEST(BitmapTexture, LoadsFileAndLinearizesOnce) {
     EXPECT_THROW(BitmapTexture::load(path), std::runtime_error);
 }
 
+TEST(BitmapTexture, EightBitFilesReadAsCodesEqualTheFloatPath) {
+    // load() keeps an 8-bit file's codes without a float copy; the texture must be the one built from
+    // read_image's floats: same texels, means and channel count, with and without alpha, raw or not.
+    for (int channels : {1, 2, 3, 4}) {
+        Image img(5, 3, channels);
+        for (size_t i = 0; i < img.data.size(); ++i) img.data[i] = float((i * 37) % 101) / 100.f;
+        const std::string path = (std::filesystem::temp_directory_path() / "neepp_test_bytes.png").string();
+        write_png_srgb(path, img);
+        ASSERT_TRUE(read_image_bytes(path).has_value());
+        for (bool raw : {false, true}) {
+            SCOPED_TRACE(testing::Message() << channels << " channels, raw " << raw);
+            BitmapOptions options;
+            options.raw = raw;
+            auto from_codes = BitmapTexture::load(path, options);
+            BitmapTexture from_floats(read_image(path), options);
+            EXPECT_EQ(from_codes->channels(), from_floats.channels());
+            EXPECT_EQ(from_codes->mean().x, from_floats.mean().x);
+            EXPECT_EQ(from_codes->mean_rgb().z, from_floats.mean_rgb().z);
+            for (float u : {0.05f, 0.3f, 0.71f})
+                for (float v : {0.1f, 0.5f, 0.93f}) {
+                    const Color a = from_codes->eval(at_uv(u, v)), b = from_floats.eval(at_uv(u, v));
+                    EXPECT_EQ(a.x, b.x);
+                    EXPECT_EQ(a.y, b.y);
+                    EXPECT_EQ(a.z, b.z);
+                }
+        }
+        std::filesystem::remove(path);
+    }
+    // Files read as floats have no 8-bit reading.
+    const std::string exr = (std::filesystem::temp_directory_path() / "neepp_test_bytes.exr").string();
+    write_exr(exr, coords_image(2, 2));
+    EXPECT_FALSE(read_image_bytes(exr).has_value());
+    std::filesystem::remove(exr);
+    EXPECT_THROW(read_image_bytes(exr), std::runtime_error);
+}
+
 TEST(BitmapTexture, Eval1IsLuminanceOrTheSingleChannel) {
     BitmapTexture rgb(coords_image(W, H));
     EXPECT_NEAR(rgb.eval_1(center(2, 1)), luminance(Color(2, 1, 16)), 1e-5f);

@@ -63,7 +63,7 @@ struct JpegError {
     char message[JMSG_LENGTH_MAX] = {};
 };
 
-Image read_jpeg(const std::string &path) {
+ImageBytes read_jpeg(const std::string &path) {
     std::unique_ptr<FILE, int (*)(FILE *)> f(std::fopen(path.c_str(), "rb"), &std::fclose);
     if (!f) fail(path, "cannot open file");
     jpeg_decompress_struct cinfo;
@@ -74,7 +74,7 @@ Image read_jpeg(const std::string &path) {
         e->mgr.format_message(c, e->message);
         std::longjmp(e->jump, 1);
     };
-    Image img;
+    ImageBytes img;
     if (setjmp(err.jump)) {  // libjpeg reports errors by longjmp to here
         jpeg_destroy_decompress(&cinfo);
         fail(path, std::string("corrupt JPEG file: ") + err.message);
@@ -88,15 +88,11 @@ Image read_jpeg(const std::string &path) {
         jpeg_destroy_decompress(&cinfo);
         fail(path, "unsupported JPEG color layout (only gray and RGB)");
     }
-    img = Image(w, h, n);
-    img.srgb_encoded = true;
-    // The scanline buffer comes from libjpeg's pool: a longjmp must not skip a C++ destructor.
-    JSAMPARRAY row = (*cinfo.mem->alloc_sarray)(reinterpret_cast<j_common_ptr>(&cinfo), JPOOL_IMAGE,
-                                                JDIMENSION(w * n), 1);
+    img.width = w, img.height = h, img.channels = n;
+    img.data.resize(size_t(w) * h * n);
     while (cinfo.output_scanline < cinfo.output_height) {
-        float *dst = &img.data[size_t(cinfo.output_scanline) * w * n];
-        jpeg_read_scanlines(&cinfo, row, 1);
-        for (int i = 0; i < w * n; ++i) dst[i] = float(row[0][i]) * (1.f / 255.f);
+        JSAMPROW row = &img.data[size_t(cinfo.output_scanline) * w * n];  // decoded in place
+        jpeg_read_scanlines(&cinfo, &row, 1);
     }
     jpeg_finish_decompress(&cinfo);
     jpeg_destroy_decompress(&cinfo);
@@ -151,6 +147,24 @@ Image image_from_stb(T *pixels, int w, int h, int n, float scale, bool srgb) {
     return img;
 }
 
+[[noreturn]] void fail_stb(const std::string &path) {
+    const char *why = stbi_failure_reason();
+    fail(path, fmt::format("unsupported or corrupt image file ({})", why ? why : "unknown error"));
+}
+
+bool stb_is_8_bit(const std::string &path) { return !stbi_is_hdr(path.c_str()) && !stbi_is_16_bit(path.c_str()); }
+
+ImageBytes read_stb_8_bit(const std::string &path) {
+    int w = 0, h = 0, n = 0;
+    stbi_uc *px = stbi_load(path.c_str(), &w, &h, &n, 0);
+    if (!px) fail_stb(path);
+    ImageBytes img;
+    img.width = w, img.height = h, img.channels = n;
+    img.data.assign(px, px + size_t(w) * h * n);
+    stbi_image_free(px);
+    return img;
+}
+
 // stbi_loadf is avoided for integer files: it applies a gamma-2.2 curve instead of keeping the codes.
 Image read_stb(const std::string &path) {
     const char *p = path.c_str();
@@ -160,12 +174,24 @@ Image read_stb(const std::string &path) {
     } else if (stbi_is_16_bit(p)) {
         if (stbi_us *px = stbi_load_16(p, &w, &h, &n, 0))
             return image_from_stb(px, w, h, n, 1.f / 65535.f, true);
-    } else if (stbi_uc *px = stbi_load(p, &w, &h, &n, 0)) {
-        // Multiplying by the reciprocal (not dividing) reproduces Dr.Jit's 8-bit texel decode bit for bit.
-        return image_from_stb(px, w, h, n, 1.f / 255.f, true);
     }
-    const char *why = stbi_failure_reason();
-    fail(path, fmt::format("unsupported or corrupt image file ({})", why ? why : "unknown error"));
+    fail_stb(path);
+}
+
+// 8-bit codes as Image's normalized floats. Multiplying by the reciprocal (not dividing) reproduces
+// Dr.Jit's 8-bit texel decode bit for bit.
+Image image_from_bytes(const ImageBytes &bytes) {
+    Image img(bytes.width, bytes.height, bytes.channels);
+    for (size_t i = 0; i < img.data.size(); ++i) img.data[i] = float(bytes.data[i]) * (1.f / 255.f);
+    img.srgb_encoded = true;
+    return img;
+}
+
+// The file's kind after checking that it exists.
+FileKind kind_of(const std::string &path) {
+    std::error_code ec;
+    if (!std::filesystem::is_regular_file(path, ec)) fail(path, "no such file");
+    return sniff(path);
 }
 
 void check_writable(const std::string &path, const Image &img) {
@@ -177,16 +203,27 @@ void check_writable(const std::string &path, const Image &img) {
 
 }  // namespace
 
-Image read_image(const std::string &path) {
-    std::error_code ec;
-    if (!std::filesystem::is_regular_file(path, ec)) fail(path, "no such file");
-    switch (sniff(path)) {
-        case FileKind::Exr: return read_exr(path);
+namespace {
+
+std::optional<ImageBytes> read_bytes(const std::string &path, FileKind kind) {
+    switch (kind) {
+        case FileKind::Exr: return std::nullopt;
 #ifdef NEEPP_HAVE_LIBJPEG
         case FileKind::Jpeg: return read_jpeg(path);
 #endif
-        default: return read_stb(path);
+        default: return stb_is_8_bit(path) ? std::optional<ImageBytes>(read_stb_8_bit(path)) : std::nullopt;
     }
+}
+
+}  // namespace
+
+std::optional<ImageBytes> read_image_bytes(const std::string &path) { return read_bytes(path, kind_of(path)); }
+
+Image read_image(const std::string &path) {
+    const FileKind kind = kind_of(path);
+    if (kind == FileKind::Exr) return read_exr(path);
+    if (std::optional<ImageBytes> bytes = read_bytes(path, kind)) return image_from_bytes(*bytes);
+    return read_stb(path);
 }
 
 void write_exr(const std::string &path, const Image &img, bool half) {

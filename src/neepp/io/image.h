@@ -1,5 +1,7 @@
 // In-memory float RGB(A) images and reading/writing them (OpenEXR for HDR, PNG/JPEG through stb_image).
 #pragma once
+#include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
 #include "neepp/math/vec.h"
@@ -30,6 +32,17 @@ struct Image {
 // PNG included); the caller decides whether to linearize (Mitsuba's `raw` flag). Alpha is kept.
 // Throws std::runtime_error naming the path on any failure.
 Image read_image(const std::string &path);
+
+// An 8-bit file's codes as stored (sRGB-encoded, alpha last), for readers that keep 8-bit data (bitmap
+// textures) and so need no float copy of a large image.
+struct ImageBytes {
+    int width = 0, height = 0, channels = 3;
+    std::vector<uint8_t> data;  // row-major, top row first, interleaved channels
+    int color_channels() const { return channels == 2 || channels == 4 ? channels - 1 : channels; }  // 1 or 3
+};
+// JPEG and 8-bit PNG, TGA, BMP as their codes; std::nullopt for the files read_image reads as floats
+// (OpenEXR, HDR, 16-bit). Throws as read_image does.
+std::optional<ImageBytes> read_image_bytes(const std::string &path);
 
 // Writes the image to OpenEXR (half or float; channels named Y, YA, RGB or RGBA). Throws on failure.
 void write_exr(const std::string &path, const Image &img, bool half = false);

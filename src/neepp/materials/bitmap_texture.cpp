@@ -65,13 +65,27 @@ struct BitmapTexture::Lookup {
     float wx0, wx1, wy0, wy1;  // bilinear weights toward the lower / upper texel
 };
 
+template <typename Value>
+void BitmapTexture::compute_means(Value value) {
+    const size_t pixels = size_t(width_) * height_;
+    double sum = 0, sum_rgb[3] = {0, 0, 0};
+    for (size_t i = 0; i < pixels; ++i) {
+        float t[3];
+        for (int c = 0; c < channels_; ++c) sum_rgb[c] += t[c] = value(i * channels_ + c);
+        sum += channels_ == 1 ? t[0] : luminance(Color(t[0], t[1], t[2]));
+    }
+    mean_ = float(sum / double(pixels));
+    mean_rgb_ = channels_ == 1 ? Color(mean_)
+                               : Color(float(sum_rgb[0] / pixels), float(sum_rgb[1] / pixels),
+                                       float(sum_rgb[2] / pixels));
+}
+
 BitmapTexture::BitmapTexture(const Image &image, const BitmapOptions &options)
     : width_(image.width), height_(image.height), channels_(image.color_channels()), options_(options),
       to_uv_(options.to_uv) {
     if (width_ <= 0 || height_ <= 0 || image.data.size() != size_t(width_) * height_ * image.channels)
         throw std::runtime_error(fmt::format("bitmap texture: invalid image ({}x{}, {} channels)", width_,
                                              height_, image.channels));
-    const bool linearize = image.srgb_encoded && !options.raw;
     const size_t pixels = size_t(width_) * height_;
     // 8-bit images stay 8-bit, decoded through a 256-entry table on lookup: a quarter of the memory
     // and cache traffic of floats (texture fetches are cache misses on large maps), same values.
@@ -85,33 +99,50 @@ BitmapTexture::BitmapTexture(const Image &image, const BitmapOptions &options)
             if (!(code >= 0.f && code <= 255.f && code * (1.f / 255.f) == v)) { all_codes = false; break; }
         }
     if (all_codes) {
-        for (int i = 0; i < 256; ++i) lut_[i] = linearize ? decode_srgb(float(i) * (1.f / 255.f)) : float(i) * (1.f / 255.f);
         codes_.resize(pixels * channels_);
-    } else {
-        texels_.resize(pixels * channels_);
+        for (size_t i = 0; i < pixels; ++i)
+            for (int c = 0; c < channels_; ++c)  // alpha (the last source channel) is dropped, as in Mitsuba
+                codes_[i * channels_ + c] = uint8_t(std::nearbyint(image.data[i * image.channels + c] * 255.f));
+        finish_codes(image.srgb_encoded);
+        return;
     }
-    double sum = 0, sum_rgb[3] = {0, 0, 0};
-    for (size_t i = 0; i < pixels; ++i) {
-        float t[3];
+    const bool linearize = image.srgb_encoded && !options.raw;
+    texels_.resize(pixels * channels_);
+    for (size_t i = 0; i < pixels; ++i)
         for (int c = 0; c < channels_; ++c) {  // alpha (the last source channel) is dropped, as in Mitsuba
-            float v = image.data[i * image.channels + c];
-            if (all_codes) {
-                codes_[i * channels_ + c] = uint8_t(std::nearbyint(v * 255.f));
-                t[c] = lut_[codes_[i * channels_ + c]];
-            } else {
-                t[c] = texels_[i * channels_ + c] = linearize ? decode_srgb(v) : v;
-            }
-            sum_rgb[c] += t[c];
+            const float v = image.data[i * image.channels + c];
+            texels_[i * channels_ + c] = linearize ? decode_srgb(v) : v;
         }
-        sum += channels_ == 1 ? t[0] : luminance(Color(t[0], t[1], t[2]));
+    compute_means([&](size_t i) { return texels_[i]; });
+}
+
+BitmapTexture::BitmapTexture(ImageBytes image, const BitmapOptions &options)
+    : width_(image.width), height_(image.height), channels_(image.color_channels()), options_(options),
+      to_uv_(options.to_uv) {
+    if (width_ <= 0 || height_ <= 0 || image.channels < 1 || image.channels > 4 ||
+        image.data.size() != size_t(width_) * height_ * image.channels)
+        throw std::runtime_error(fmt::format("bitmap texture: invalid image ({}x{}, {} channels)", width_,
+                                             height_, image.channels));
+    if (channels_ == image.channels) {
+        codes_ = std::move(image.data);
+    } else {  // alpha (the last channel) is dropped, as in Mitsuba
+        const size_t pixels = size_t(width_) * height_;
+        codes_.resize(pixels * channels_);
+        for (size_t i = 0; i < pixels; ++i)
+            for (int c = 0; c < channels_; ++c) codes_[i * channels_ + c] = image.data[i * image.channels + c];
     }
-    mean_ = float(sum / double(pixels));
-    mean_rgb_ = channels_ == 1 ? Color(mean_)
-                               : Color(float(sum_rgb[0] / pixels), float(sum_rgb[1] / pixels),
-                                       float(sum_rgb[2] / pixels));
+    finish_codes(true);
+}
+
+void BitmapTexture::finish_codes(bool srgb) {
+    const bool linearize = srgb && !options_.raw;
+    for (int i = 0; i < 256; ++i) lut_[i] = linearize ? decode_srgb(float(i) * (1.f / 255.f)) : float(i) * (1.f / 255.f);
+    compute_means([&](size_t i) { return lut_[codes_[i]]; });
 }
 
 std::shared_ptr<BitmapTexture> BitmapTexture::load(const std::string &filename, const BitmapOptions &options) {
+    if (std::optional<ImageBytes> bytes = read_image_bytes(filename))
+        return std::make_shared<BitmapTexture>(std::move(*bytes), options);
     return std::make_shared<BitmapTexture>(read_image(filename), options);
 }
 

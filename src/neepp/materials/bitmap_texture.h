@@ -52,7 +52,10 @@ struct BitmapOptions {
 class BitmapTexture final : public Texture {
 public:
     explicit BitmapTexture(const Image &image, const BitmapOptions &options = {});
-    // Reads `filename` with read_image; throws std::runtime_error naming the path on failure.
+    // An 8-bit file's codes (sRGB-encoded, as Mitsuba reads 8-bit files), kept as they are.
+    explicit BitmapTexture(ImageBytes image, const BitmapOptions &options = {});
+    // Reads `filename` (8-bit files with read_image_bytes, without a float copy; others with read_image);
+    // throws std::runtime_error naming the path on failure.
     static std::shared_ptr<BitmapTexture> load(const std::string &filename, const BitmapOptions &options = {});
 
     Color eval(const SurfaceInteraction &si) const override;
@@ -76,6 +79,11 @@ private:
     Color texel(int x, int y) const;  // already wrapped coordinates
     Color interpolate(Vec2 uv) const;
     Color blend(const Lookup &l) const;  // bilinear blend of a located footprint
+    // With codes_ filled: the decode table (linear unless raw, srgb says whether codes are sRGB) and means.
+    void finish_codes(bool srgb);
+    // mean_ and mean_rgb_ from value(i), the linear value of channel i % channels_ of texel i / channels_.
+    template <typename Value>
+    void compute_means(Value value);
 
     int width_ = 0, height_ = 0, channels_ = 3;
     std::vector<float> texels_;     // float data (HDR images), or empty when codes_ is used
