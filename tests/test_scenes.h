@@ -32,6 +32,9 @@ inline std::string scene_header_xml(int max_depth, int fov, const std::string &o
 inline std::string write_temp_scene(const std::string &xml, const std::string &name = "scene.xml") {
     static int counter = 0;
     auto dir = std::filesystem::temp_directory_path() / ("neepp_test_" + std::to_string(::getpid()) + "_" + std::to_string(counter++));
+    // A folder of that name is a dead process's (PIDs are reused, and nothing removes these folders): its
+    // files, e.g. a damaged visibility map a test left, must not leak into this test.
+    std::filesystem::remove_all(dir);
     std::filesystem::create_directories(dir);
     auto path = dir / name;
     std::ofstream(path) << xml;

@@ -6,6 +6,7 @@
 
 #include "neepp/materials/bitmap_texture.h"
 #include "neepp/materials/checkerboard_texture.h"
+#include "common/temp_dir.h"
 
 using namespace neepp;
 
@@ -159,14 +160,15 @@ TEST(BitmapTexture, LoadsFileAndLinearizesOnce) {
 TEST(BitmapTexture, EightBitFilesReadAsCodesEqualTheFloatPath) {
     // load() keeps an 8-bit file's codes without a float copy; the texture must be the one built from
     // read_image's floats: same texels, means and channel count, with and without alpha, raw or not.
+    const neepp::testing::TempDir tmp;
     for (int channels : {1, 2, 3, 4}) {
         Image img(5, 3, channels);
         for (size_t i = 0; i < img.data.size(); ++i) img.data[i] = float((i * 37) % 101) / 100.f;
-        const std::string path = (std::filesystem::temp_directory_path() / "neepp_test_bytes.png").string();
+        const std::string path = (tmp.dir / "bytes.png").string();
         write_png_srgb(path, img);
         ASSERT_TRUE(read_image_bytes(path).has_value());
         for (bool raw : {false, true}) {
-            SCOPED_TRACE(testing::Message() << channels << " channels, raw " << raw);
+            SCOPED_TRACE(::testing::Message() << channels << " channels, raw " << raw);
             BitmapOptions options;
             options.raw = raw;
             auto from_codes = BitmapTexture::load(path, options);
@@ -185,7 +187,7 @@ TEST(BitmapTexture, EightBitFilesReadAsCodesEqualTheFloatPath) {
         std::filesystem::remove(path);
     }
     // Files read as floats have no 8-bit reading.
-    const std::string exr = (std::filesystem::temp_directory_path() / "neepp_test_bytes.exr").string();
+    const std::string exr = (tmp.dir / "bytes.exr").string();
     write_exr(exr, coords_image(2, 2));
     EXPECT_FALSE(read_image_bytes(exr).has_value());
     std::filesystem::remove(exr);
