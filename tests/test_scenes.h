@@ -29,13 +29,23 @@ inline std::string scene_header_xml(int max_depth, int fov, const std::string &o
 }
 
 // Writes xml to a fresh file in the temp directory and returns its path.
+// The folders are removed when the test process exits.
 inline std::string write_temp_scene(const std::string &xml, const std::string &name = "scene.xml") {
+    struct Folders {
+        std::vector<std::filesystem::path> made;
+        ~Folders() {
+            std::error_code ec;
+            for (const auto &d : made) std::filesystem::remove_all(d, ec);
+        }
+    };
+    static Folders folders;
     static int counter = 0;
     auto dir = std::filesystem::temp_directory_path() / ("neepp_test_" + std::to_string(::getpid()) + "_" + std::to_string(counter++));
-    // A folder of that name is a dead process's (PIDs are reused, and nothing removes these folders): its
-    // files, e.g. a damaged visibility map a test left, must not leak into this test.
+    // A folder of that name is a dead process's (PIDs are reused, and a crashed test leaves its folders):
+    // its files, e.g. a damaged visibility map, must not leak into this test.
     std::filesystem::remove_all(dir);
     std::filesystem::create_directories(dir);
+    folders.made.push_back(dir);
     auto path = dir / name;
     std::ofstream(path) << xml;
     return path.string();
