@@ -42,9 +42,9 @@ EnvironmentMapLight::EnvironmentMapLight(Image image, const Transform &to_world,
         for (int x = 0; x < w; ++x) texel_lum[size_t(y) * w + x] = luminance(texel(x, y));
     auto corner_row = [&](int y, std::vector<float> &row) {
         for (int x = 0; x <= w; ++x) {
-            const Bilinear b = bilinear(Vec2(float(x) / float(w), float(y) / float(h)));
-            const float l = texel_lum[b.i00] * b.w00 + texel_lum[b.i10] * b.w10 + texel_lum[b.i01] * b.w01 +
-                            texel_lum[b.i11] * b.w11;
+            const float l = bilinear(Vec2(float(x) / float(w), float(y) / float(h))).blend([&](size_t i) {
+                return texel_lum[i];
+            });
             row[x] = std::max(l, 0.f);
         }
     };
@@ -134,8 +134,7 @@ EnvironmentMapLight::Bilinear EnvironmentMapLight::bilinear(Vec2 uv) const {
 }
 
 Color EnvironmentMapLight::lookup(Vec2 uv) const {
-    const Bilinear b = bilinear(uv);
-    return texel(b.i00) * b.w00 + texel(b.i10) * b.w10 + texel(b.i01) * b.w01 + texel(b.i11) * b.w11;
+    return bilinear(uv).blend([&](size_t i) { return texel(i); });
 }
 
 Color EnvironmentMapLight::eval_environment(const Vec3 &d) const { return lookup(direction_to_uv(d)) * scale_; }

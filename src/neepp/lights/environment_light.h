@@ -38,6 +38,11 @@ private:
     struct Bilinear {
         size_t i00, i10, i01, i11;
         float w00, w10, w01, w11;
+        // The weighted sum of at(index) over the four texels (a colour, or a per-texel luminance).
+        template <typename At>
+        auto blend(At at) const {
+            return at(i00) * w00 + at(i10) * w10 + at(i01) * w01 + at(i11) * w11;
+        }
     };
     Bilinear bilinear(Vec2 uv) const;
     // Texels as half floats (RGB, 6 bytes): a 2k map is 12.6 MB instead of 25 MB, so with the sampling

@@ -65,6 +65,21 @@ struct BitmapTexture::Lookup {
     float wx0, wx1, wy0, wy1;  // bilinear weights toward the lower / upper texel
 };
 
+namespace {
+
+// out = convert(v) for the colour channels of src (src_channels per texel); alpha, the last source
+// channel, is dropped, as in Mitsuba.
+template <typename Out, typename Src, typename Convert>
+void copy_color_channels(std::vector<Out> &out, const std::vector<Src> &src, int src_channels, int channels,
+                         Convert convert) {
+    const size_t pixels = src.size() / size_t(src_channels);
+    out.resize(pixels * channels);
+    for (size_t i = 0; i < pixels; ++i)
+        for (int c = 0; c < channels; ++c) out[i * channels + c] = convert(src[i * src_channels + c]);
+}
+
+}  // namespace
+
 template <typename Value>
 void BitmapTexture::compute_means(Value value) {
     const size_t pixels = size_t(width_) * height_;
@@ -99,20 +114,14 @@ BitmapTexture::BitmapTexture(const Image &image, const BitmapOptions &options)
             if (!(code >= 0.f && code <= 255.f && code * (1.f / 255.f) == v)) { all_codes = false; break; }
         }
     if (all_codes) {
-        codes_.resize(pixels * channels_);
-        for (size_t i = 0; i < pixels; ++i)
-            for (int c = 0; c < channels_; ++c)  // alpha (the last source channel) is dropped, as in Mitsuba
-                codes_[i * channels_ + c] = uint8_t(std::nearbyint(image.data[i * image.channels + c] * 255.f));
+        copy_color_channels(codes_, image.data, image.channels, channels_,
+                            [](float v) { return uint8_t(std::nearbyint(v * 255.f)); });
         finish_codes(image.srgb_encoded);
         return;
     }
     const bool linearize = image.srgb_encoded && !options.raw;
-    texels_.resize(pixels * channels_);
-    for (size_t i = 0; i < pixels; ++i)
-        for (int c = 0; c < channels_; ++c) {  // alpha (the last source channel) is dropped, as in Mitsuba
-            const float v = image.data[i * image.channels + c];
-            texels_[i * channels_ + c] = linearize ? decode_srgb(v) : v;
-        }
+    copy_color_channels(texels_, image.data, image.channels, channels_,
+                        [&](float v) { return linearize ? decode_srgb(v) : v; });
     compute_means([&](size_t i) { return texels_[i]; });
 }
 
@@ -123,14 +132,8 @@ BitmapTexture::BitmapTexture(ImageBytes image, const BitmapOptions &options)
         image.data.size() != size_t(width_) * height_ * image.channels)
         throw std::runtime_error(fmt::format("bitmap texture: invalid image ({}x{}, {} channels)", width_,
                                              height_, image.channels));
-    if (channels_ == image.channels) {
-        codes_ = std::move(image.data);
-    } else {  // alpha (the last channel) is dropped, as in Mitsuba
-        const size_t pixels = size_t(width_) * height_;
-        codes_.resize(pixels * channels_);
-        for (size_t i = 0; i < pixels; ++i)
-            for (int c = 0; c < channels_; ++c) codes_[i * channels_ + c] = image.data[i * image.channels + c];
-    }
+    if (channels_ == image.channels) codes_ = std::move(image.data);
+    else copy_color_channels(codes_, image.data, image.channels, channels_, [](uint8_t v) { return v; });
     finish_codes(true);
 }
 
