@@ -232,8 +232,9 @@ void PathIntegrator::Li_batch(const Scene &scene, std::span<const Ray> rays, std
         // Each stage runs over every live path before the next starts, so a prefetch issued for one path
         // has the other paths' work to complete in.
         for (size_t live = n; live > 0;) {
-            // Rays go to Embree as packets of 16 (its widest on AVX-512), as Mitsuba's vectorized variants
-            // trace them: cheaper per ray than one at a time, most of all for a tile's coherent camera rays.
+            // Rays go to Embree 16 at a time, as packets of its native width (Scene::packet_width), as
+            // Mitsuba's vectorized variants trace them: cheaper per ray than one at a time, most of all for
+            // a tile's coherent camera rays.
             for (size_t k0 = 0; k0 < live; k0 += 16) {
                 const Ray *rs[16];
                 RayHit *hs[16];

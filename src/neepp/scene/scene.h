@@ -48,7 +48,7 @@ public:
 
     bool intersect(const Ray &ray, SurfaceInteraction &si) const;  // trace + fill
     RayHit trace(const Ray &ray) const;
-    // trace() of up to 16 rays at once, as one Embree packet; coherent: the rays start close together in
+    // trace() of up to 16 rays at once, as Embree packets of packet_width(); coherent: the rays start close together in
     // similar directions (camera rays of a few neighbouring pixels), so Embree may use its coherent
     // traversal (bathroom, callgrind: -0.8 % instructions; for shadow rays toward lights it cost +1.7 %).
     void trace16(const Ray *const *rays, RayHit *const *hits, int n, bool coherent = false) const;
@@ -61,7 +61,11 @@ public:
         si.wi = si.to_local(-ray.d);
     }
     bool occluded(const Ray &ray) const;
-    void occluded16(const Ray *const *rays, int n, bool *occluded) const;  // up to 16 rays, one packet
+    void occluded16(const Ray *const *rays, int n, bool *occluded) const;  // up to 16 rays, as packets
+    // The lanes of the packets trace16 and occluded16 give Embree: the widest this CPU traces natively
+    // (16 with AVX-512, 8 with AVX2, else 4). Settable (4, 8, 16) for tests and measurements.
+    int packet_width() const { return packet_width_; }
+    void set_packet_width(int width);
 
     const std::vector<std::unique_ptr<Shape>> &shapes() const { return shapes_; }
     const std::vector<LightPtr> &lights() const { return lights_; }
@@ -77,6 +81,7 @@ public:
 private:
     RTCDevice device_ = nullptr;
     RTCScene rtc_scene_ = nullptr;
+    int packet_width_ = 16;
     std::vector<std::unique_ptr<Shape>> shapes_;
     std::vector<LightPtr> lights_;
     std::vector<const Light *> infinite_lights_;
