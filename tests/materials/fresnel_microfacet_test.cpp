@@ -132,5 +132,37 @@ TEST(Microfacet, SampledNormalsHaveTheirPdf) {
         }
 }
 
+// The albedo quadrature integrates half the sample square when wi lies in the xz-plane, relying on a
+// mirrored sample (u.x -> 1 - u.x for GGX, u.y -> 1 - u.y for Beckmann) giving the mirrored normal. Both
+// are checked here: the mirror property itself, and the albedos against those of a wi turned by a tiny
+// azimuth (which an isotropic distribution does not feel, and which integrates the whole square).
+TEST(Microfacet, AlbedoQuadratureUsesTheMirrorSymmetry) {
+    for (auto type : {MicrofacetType::GGX, MicrofacetType::Beckmann})
+        for (float alpha : {0.05f, 0.2f, 0.6f}) {
+            MicrofacetDistribution d(type, alpha);
+            for (float mu : {0.05f, 0.4f, 0.9f, 1.f}) {
+                const float s = std::sqrt(1.f - mu * mu);
+                const Vec3 wi(s, 0.f, mu);
+                for (float a = 0.05f; a < 1.f; a += 0.1f)
+                    for (float b = 0.05f; b < 1.f; b += 0.15f) {
+                        const Vec2 u(a, b);
+                        const Vec2 mirrored = type == MicrofacetType::GGX ? Vec2(1.f - a, b) : Vec2(a, 1.f - b);
+                        const Vec3 m = d.sample_normal(wi, u), mm = d.sample_normal(wi, mirrored);
+                        EXPECT_NEAR(mm.x, m.x, 2e-5f);
+                        EXPECT_NEAR(mm.y, -m.y, 2e-5f);
+                        EXPECT_NEAR(mm.z, m.z, 2e-5f);
+                    }
+                const float phi = 1e-3f;
+                const Vec3 turned(s * std::cos(phi), s * std::sin(phi), mu);
+                for (float eta : {1.5f, 1.f / 1.5f}) {
+                    EXPECT_NEAR(eval_reflectance(d, wi, eta), eval_reflectance(d, turned, eta), 2e-5f)
+                        << "alpha " << alpha << " mu " << mu << " eta " << eta;
+                    EXPECT_NEAR(eval_transmittance(d, wi, eta), eval_transmittance(d, turned, eta), 2e-5f)
+                        << "alpha " << alpha << " mu " << mu << " eta " << eta;
+                }
+            }
+        }
+}
+
 }  // namespace
 }  // namespace neepp

@@ -217,17 +217,27 @@ const Quadrature &cached_gauss_legendre(int n) {
 }
 
 // Integrates over the visible-normal sample square; `term(m)` is the per-microfacet contribution.
+// With an isotropic distribution and wi in the xz-plane (the tables' case), mirroring one coordinate of the
+// sample square, u -> 1 - u, mirrors the sampled normal across that plane (m.y -> -m.y): the coordinate
+// GGX's concentric disk maps to the slope's y (u.x), or Beckmann's second inversion (u.y). The terms are
+// the same for m and its mirror image (wo mirrors, and Fresnel and G1 see only dot(wi, m), v.y^2 and z),
+// and the Gauss-Legendre nodes are symmetric, so half the nodes of that axis, counted twice, give the
+// same sum up to rounding at half the cost (rough plastic's tables: 2 x 64 quadratures of 128^2 nodes).
 template <typename Term>
 float integrate_visible_normals(const MicrofacetDistribution &distr, const Vec3 &wi, float eta, Term term) {
     const Quadrature &q = cached_gauss_legendre(eta > 1.f ? 32 : 128);
-    int n = int(q.nodes.size());
+    const int n = int(q.nodes.size());
+    const bool mirrored = distr.alpha_u() == distr.alpha_v() && wi.y == 0.f;
+    const bool mirror_x = distr.type() == MicrofacetType::GGX;
+    const int ni = mirrored && mirror_x ? n / 2 : n, nj = mirrored && !mirror_x ? n / 2 : n;
+    // 0.25: the weights are for [-1, 1]^2, the sample square is [0, 1]^2.
+    const float scale = mirrored ? 0.5f : 0.25f;
     float result = 0.f;
-    for (int j = 0; j < n; ++j)
-        for (int i = 0; i < n; ++i) {
+    for (int j = 0; j < nj; ++j)
+        for (int i = 0; i < ni; ++i) {
             Vec2 node(q.nodes[i] * 0.5f + 0.5f, q.nodes[j] * 0.5f + 0.5f);
             Vec3 m = distr.sample_normal(wi, node);
-            // 0.25: the weights are for [-1, 1]^2, the sample square is [0, 1]^2.
-            result += term(m) * (q.weights[i] * q.weights[j]) * 0.25f;
+            result += term(m) * (q.weights[i] * q.weights[j]) * scale;
         }
     return result;
 }
