@@ -1,4 +1,4 @@
-// The command-line tool's huge-page set-up: the tunable is added to what the user set, never overrides a
+// The command-line tool's huge-page set-up: the tunables are added to what the user set, never overrides a
 // choice of theirs, and the statistics read back whether it is on.
 #include <gtest/gtest.h>
 
@@ -9,9 +9,14 @@
 using namespace neepp;
 
 TEST(HugePages, TunableIsAddedToWhatIsSet) {
-    EXPECT_EQ(tunables_with_huge_pages(nullptr), "glibc.malloc.hugetlb=1");
-    EXPECT_EQ(tunables_with_huge_pages(""), "glibc.malloc.hugetlb=1");
-    EXPECT_EQ(tunables_with_huge_pages("glibc.malloc.arena_max=2"), "glibc.malloc.arena_max=2:glibc.malloc.hugetlb=1");
+    const std::string added =
+        "glibc.malloc.hugetlb=1:glibc.malloc.mmap_threshold=33554432:glibc.malloc.trim_threshold=268435456";
+    EXPECT_EQ(tunables_with_huge_pages(nullptr), added);
+    EXPECT_EQ(tunables_with_huge_pages(""), added);
+    EXPECT_EQ(tunables_with_huge_pages("glibc.malloc.arena_max=2"), "glibc.malloc.arena_max=2:" + added);
+    // A threshold the user chose is kept.
+    EXPECT_EQ(tunables_with_huge_pages("glibc.malloc.mmap_threshold=65536"),
+              "glibc.malloc.mmap_threshold=65536:glibc.malloc.hugetlb=1:glibc.malloc.trim_threshold=268435456");
     // Already chosen, on or off: nothing to add (and so no restart).
     EXPECT_EQ(tunables_with_huge_pages("glibc.malloc.hugetlb=0"), "");
     EXPECT_EQ(tunables_with_huge_pages("glibc.malloc.arena_max=2:glibc.malloc.hugetlb=1"), "");

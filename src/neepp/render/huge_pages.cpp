@@ -1,18 +1,32 @@
 #include "neepp/render/huge_pages.h"
 
 #include <cstdlib>
+#include <utility>
 #include <unistd.h>
 
 namespace neepp {
 
 namespace {
 constexpr const char *kTunable = "glibc.malloc.hugetlb";
-}
+// With huge pages, every block glibc maps on its own (those over the mmap threshold, 128 KB to 32 MB,
+// adjusted as it goes) is a fresh mapping whose 2 MB pages the kernel zeroes whole on first touch, and
+// loading a scene allocates and frees many such blocks (a mesh's arrays, growing as it is parsed; decoded
+// images): bathroom spent a quarter of a second of its load zeroing pages. Blocks under 32 MB therefore
+// come from the heap, and freed memory stays there (up to 256 MB at its top) for the next ones.
+constexpr std::pair<const char *, const char *> kWith[] = {{"glibc.malloc.mmap_threshold", "33554432"},
+                                                           {"glibc.malloc.trim_threshold", "268435456"}};
+}  // namespace
 
 std::string tunables_with_huge_pages(const char *current) {
-    const std::string tunables = current ? current : "";
+    std::string tunables = current ? current : "";
     if (tunables.find(kTunable) != std::string::npos) return {};
-    return tunables.empty() ? std::string(kTunable) + "=1" : tunables + ":" + kTunable + "=1";
+    auto add = [&](const std::string &name, const char *value) {
+        if (tunables.find(name) != std::string::npos) return;  // the user's value stays
+        tunables += (tunables.empty() ? "" : ":") + name + "=" + value;
+    };
+    add(kTunable, "1");
+    for (const auto &[name, value] : kWith) add(name, value);
+    return tunables;
 }
 
 void restart_with_huge_pages(char **argv) {
