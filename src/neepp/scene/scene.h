@@ -48,9 +48,10 @@ public:
 
     bool intersect(const Ray &ray, SurfaceInteraction &si) const;  // trace + fill
     RayHit trace(const Ray &ray) const;
-    // trace() of up to 16 rays at once, as Embree packets of packet_width(); coherent: the rays start close together in
-    // similar directions (camera rays of a few neighbouring pixels), so Embree may use its coherent
-    // traversal (bathroom, callgrind: -0.8 % instructions; for shadow rays toward lights it cost +1.7 %).
+    // trace() of up to 16 rays at once, as Embree packets of packet_width(); coherent: the rays start
+    // close together in similar directions (camera rays of a few neighbouring pixels), so Embree may use
+    // its coherent traversal (bathroom, callgrind: -0.8 % instructions; for shadow rays toward lights it
+    // cost +1.7 %).
     void trace16(const Ray *const *rays, RayHit *const *hits, int n, bool coherent = false) const;
     // Prefetches what fill() will read for hit (its triangle's record). A hint: no effect on results.
     void prefetch(const RayHit &hit) const {
