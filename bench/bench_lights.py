@@ -30,7 +30,7 @@ sys.path.insert(0, str(REPO / "python"))
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
 from bench_neepp import downsample, table  # noqa: E402
-from neepp_tools import REFERENCES, SCENES_DIR, credit, exr, metrics, report, runner  # noqa: E402
+from neepp_tools import REFERENCES, SCENES_DIR, credit, exr, machine, metrics, report, runner  # noqa: E402
 
 SAMPLERS = ["power", "uniform", "spatial", "spatial-oriented", "bvh", "visibility", "visibility-power", "visibility-bvh"]
 MANY_LIGHT_SCENES = ["office", "corridor", "courtyard"]
@@ -130,7 +130,7 @@ def main(argv=None) -> int:
     samplers, policies = a.samplers.split(","), a.policies.split(",")
     out = Path(a.out)
     out.mkdir(parents=True, exist_ok=True)
-    results, md, summary = {}, [f"# Light selection ({a.spp} spp and equal time)\n"], []
+    results, md, summary = {}, [f"# Light selection ({a.spp} spp and equal time)\n\nmachine: {machine.summary()}\n"], []
 
     for scene in a.scenes.split(","):
         xml, w, h, depth, ref, ref_desc, extra = scene_setup(scene, a)

@@ -30,7 +30,7 @@ import numpy as np
 REPO = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(REPO / "python"))
 
-from neepp_tools import REFERENCES, SCENES_DIR, credit, exr, metrics, report, runner  # noqa: E402
+from neepp_tools import REFERENCES, SCENES_DIR, credit, exr, machine, metrics, report, runner  # noqa: E402
 
 POLICIES = ["nee", "neepp", "neepp-adaptive", "neepp-cv"]
 
@@ -105,7 +105,7 @@ def main(argv=None) -> int:
     policies = a.policies.split(",")
     out = Path(a.out)
     out.mkdir(parents=True, exist_ok=True)
-    results, md = {}, ["# NEE++ vs NEE (path integrator, max_depth %d)\n" % a.max_depth]
+    results, md = {}, ["# NEE++ vs NEE (path integrator, max_depth %d)\n\nmachine: %s\n" % (a.max_depth, machine.summary())]
     for scene in a.scenes.split(","):
         W, H, _, ref_name = REFERENCES[scene]
         w, h = W // a.scale, H // a.scale

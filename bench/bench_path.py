@@ -34,7 +34,7 @@ from pathlib import Path
 REPO = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(REPO / "python"))
 
-from neepp_tools import REFERENCES, SCENES_DIR, credit, exr, metrics, report, runner  # noqa: E402
+from neepp_tools import REFERENCES, SCENES_DIR, credit, exr, machine, metrics, report, runner  # noqa: E402
 
 
 def med(xs):
@@ -91,7 +91,8 @@ def main(argv=None) -> int:
 
     results = {"spp": a.spp, "reps": a.reps, "max_depth": a.max_depth, "variant": a.variant,
                "threads": a.threads or os.cpu_count(), "neepp": str(neepp) if neepp else None,
-               "loadavg_start": os.getloadavg(), "time": time.strftime("%Y-%m-%d %H:%M:%S"), "scenes": {}}
+               "loadavg_start": os.getloadavg(), "time": time.strftime("%Y-%m-%d %H:%M:%S"),
+               "machine": machine.describe(), "scenes": {}}
     rows = []
     for scene in scenes:
         w, h, _, _ = REFERENCES[scene]
@@ -177,7 +178,8 @@ def main(argv=None) -> int:
         credits = "\nScene credits:" + credits + "\n"
     md = (f"path, max_depth {a.max_depth}, {a.spp} spp, median of {a.reps} rep(s), "
           f"{results['threads']} threads, load avg {results['loadavg_start'][0]:.2f} -> {results['loadavg_end'][0]:.2f}; "
-          f"relMSE against shared/scenes/<scene>/reference (Mitsuba 3.9.1 llvm_ad_rgb, 2272-6032 spp)\n\n{table}\n{credits}")
+          f"relMSE against shared/scenes/<scene>/reference (Mitsuba 3.9.1 llvm_ad_rgb, 2272-6032 spp)\n"
+          f"machine: {machine.summary(results['machine'])}\n\n{table}\n{credits}")
     (out / "report.md").write_text(md)
     (out / "results.json").write_text(json.dumps(results, indent=2, default=float))
     print(md)

@@ -1,5 +1,7 @@
 // The film: reconstruction filters and filter-weighted accumulation (pixel = Σ w·L / Σ w).
 #include <gtest/gtest.h>
+#include <array>
+#include <tuple>
 #include "neepp/render/film.h"
 #include "neepp/sampling/rng.h"
 
@@ -60,4 +62,34 @@ TEST(ImageBlock, TilesWithBordersMergeToTheWholeImage) {
         }
     Image a = whole.resolve(), b = merged.resolve();
     for (size_t i = 0; i < a.data.size(); ++i) EXPECT_NEAR(a.data[i], b.data[i], 1e-5f);
+}
+
+// Each sample adds w_x·w_y·L and w_x·w_y to every pixel whose centre lies within the filter's radius, and
+// nothing elsewhere: two samples of different radiance, written out by hand against the filter profile.
+TEST(ImageBlock, PixelsHoldTheFilterWeightedMeanOfTheirSamples) {
+    for (const char *name : {"tent", "gaussian"}) {
+        const float radius = std::string(name) == "tent" ? 1.f : 2.f;
+        ReconstructionFilter f(name, radius, 0.5f);
+        ImageBlock film(0, 0, 7, 6, &f);
+        const std::array<std::tuple<float, float, Color>, 2> samples = {
+            std::tuple{2.3f, 3.1f, Color(1.f, 2.f, 3.f)}, std::tuple{3.7f, 2.6f, Color(4.f, 0.f, 0.5f)}};
+        for (auto &[x, y, L] : samples) film.put(x, y, L);
+        Image img = film.resolve();
+        int lit = 0;
+        for (int py = 0; py < 6; ++py)
+            for (int px = 0; px < 7; ++px) {
+                double sum[3] = {0, 0, 0}, weight = 0;
+                for (auto &[x, y, L] : samples) {
+                    const float dx = float(px) + 0.5f - x, dy = float(py) + 0.5f - y;
+                    if (std::abs(dx) > radius || std::abs(dy) > radius) continue;
+                    const double w = double(f.eval(dx)) * f.eval(dy);
+                    for (int c = 0; c < 3; ++c) sum[c] += w * L[c];
+                    weight += w;
+                }
+                lit += weight > 0;
+                for (int c = 0; c < 3; ++c)
+                    EXPECT_NEAR(img.at(px, py, c), weight > 0 ? sum[c] / weight : 0.0, 1e-6) << name << " " << px << "," << py;
+            }
+        EXPECT_GT(lit, 4) << name;
+    }
 }

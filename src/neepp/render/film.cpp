@@ -21,6 +21,13 @@ ImageBlock::ImageBlock(int x0, int y0, int width, int height, const Reconstructi
 
 void ImageBlock::clear() { std::fill(sums_.begin(), sums_.end(), 0.0); }
 
+namespace {
+// A pixel's four sums (r, g, b, weight) as one 256-bit vector: a sample adds w·(L, 1) to each pixel of its
+// footprint in one multiply-add, rather than four scalar ones (a gaussian's 4×4 footprint made the film
+// ~8 % of cornell-box's instructions). Unaligned, and may alias the doubles it is read from.
+typedef double Sums4 __attribute__((vector_size(32), aligned(8), may_alias));
+}  // namespace
+
 void ImageBlock::put(float px, float py, const Color &L) {
     float r = filter_->radius();
     // Pixels whose centre (i + 0.5) lies within the radius of the sample.
@@ -31,15 +38,11 @@ void ImageBlock::put(float px, float py, const Color &L) {
     if (nx <= 0 || ny <= 0 || nx > 40 || ny > 40) return;
     for (int i = 0; i < nx; ++i) wx[i] = filter_->eval(float(ix0 + i) + 0.5f - px);
     for (int j = 0; j < ny; ++j) wy[j] = filter_->eval(float(iy0 + j) + 0.5f - py);
+    const Sums4 value = {double(L.x), double(L.y), double(L.z), 1.0};
     for (int j = 0; j < ny; ++j) {
-        double *row = &sums_[(size_t(iy0 + j - y0_) * width_ + (ix0 - x0_)) * 4];
-        for (int i = 0; i < nx; ++i) {
-            double w = double(wx[i]) * wy[j];
-            row[4 * i] += w * L.x;
-            row[4 * i + 1] += w * L.y;
-            row[4 * i + 2] += w * L.z;
-            row[4 * i + 3] += w;
-        }
+        Sums4 *row = reinterpret_cast<Sums4 *>(&sums_[(size_t(iy0 + j - y0_) * width_ + (ix0 - x0_)) * 4]);
+        const double wyj = wy[j];
+        for (int i = 0; i < nx; ++i) row[i] += (double(wx[i]) * wyj) * value;
     }
 }
 
