@@ -3,7 +3,8 @@
 # builds, then runs the C++ tests (ctest) and the Python tests (pytest: CLI, comparison with Mitsuba 3).
 set -euo pipefail
 ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
-"$ROOT/scripts/install_deps.sh"
+# valgrind: tests/python/test_instructions.py runs bench/instructions.py, which counts instructions with it.
+"$ROOT/scripts/install_deps.sh" valgrind
 "$ROOT/scripts/setup_python.sh"
 "$ROOT/scripts/build.sh"
 ctest --test-dir "$ROOT/build" --output-on-failure -j2
