@@ -74,8 +74,10 @@ def parse_callgrind(path: Path) -> Counter:
                 fn = name("fn", line[3:])
             elif line.startswith("calls="):
                 skip_next = True
-            elif line.startswith(("cob=", "cfn=")):
-                name(line[:3].replace("cob", "ob").replace("cfn", "fn"), line[4:])  # registers the id's name
+            elif line.startswith("cob="):
+                name("ob", line[4:])  # a callee's object or function may be named here first
+            elif line.startswith("cfn="):
+                name("fn", line[4:])
     return costs
 
 
@@ -109,9 +111,11 @@ def per_sample(binary: Path, scene: Path, res: int, spp_a: int, spp_b: int, max_
     a = callgrind_render(binary, scene, res, spp_a, max_depth, workdir)
     b = callgrind_render(binary, scene, res, spp_b, max_depth, workdir)
     samples = res * res * (spp_b - spp_a)
+    keys = set(a) | set(b)
+    labels = {obj: object_label(obj, binary) for obj, _ in keys}
     functions: Counter = Counter()
-    for obj, fn in set(a) | set(b):
-        functions[(object_label(obj, binary), fn)] += (b[(obj, fn)] - a[(obj, fn)]) / samples
+    for obj, fn in keys:
+        functions[(labels[obj], fn)] += (b[(obj, fn)] - a[(obj, fn)]) / samples
     groups: Counter = Counter()
     for (label, _), v in functions.items():
         groups[group_of(label)] += v

@@ -123,14 +123,13 @@ std::vector<std::string> pick_exr_channels(const Imf::ChannelList &list, const s
 
 Image read_exr(const std::string &path) {
     try {
-        // OpenEXR decodes the file's blocks on its global thread pool, which is empty until given threads
-        // (classroom's 8 MB environment map took a quarter of its load on one thread).
-        static const int threads = [] {
-            const int n = int(std::max(1u, std::thread::hardware_concurrency()));
-            Imf::setGlobalThreadCount(n);
-            return n;
+        // OpenEXR decodes the file's blocks on its global thread pool (InputFile's default), which is empty
+        // until given threads (classroom's 8 MB environment map took a quarter of its load on one thread).
+        [[maybe_unused]] static const bool pool = [] {
+            Imf::setGlobalThreadCount(int(std::max(1u, std::thread::hardware_concurrency())));
+            return true;
         }();
-        Imf::InputFile file(path.c_str(), threads);
+        Imf::InputFile file(path.c_str());
         const Imath::Box2i dw = file.header().dataWindow();
         std::vector<std::string> names = pick_exr_channels(file.header().channels(), path);
         Image img(dw.max.x - dw.min.x + 1, dw.max.y - dw.min.y + 1, int(names.size()));

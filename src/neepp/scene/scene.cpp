@@ -4,6 +4,7 @@
 #include <cstdio>
 #include <stdexcept>
 #include <string>
+#include <type_traits>
 
 namespace neepp {
 namespace {
@@ -94,6 +95,16 @@ void occluded_packets(RTCScene scene, const Ray *const *rays, int n, bool *occlu
         to_embree_packet<W>(rays + b, m, r, valid);
         Packet<W>::occluded(valid, scene, &ctx, &r);
         for (int i = 0; i < m; ++i) occluded[b + i] = r.tfar[i] < 0;  // Embree sets tfar to -inf on a hit
+    }
+}
+
+// f(std::integral_constant<int, W>{}) for the packet width W (16, 8, else 4): one switch for both queries.
+template <typename F>
+void with_packet_width(int width, F &&f) {
+    switch (width) {
+    case 16: return f(std::integral_constant<int, 16>{});
+    case 8: return f(std::integral_constant<int, 8>{});
+    default: return f(std::integral_constant<int, 4>{});
     }
 }
 
@@ -200,11 +211,7 @@ RayHit Scene::trace(const Ray &ray) const {
 }
 
 void Scene::trace16(const Ray *const *rays, RayHit *const *hits, int n, bool coherent) const {
-    switch (packet_width_) {
-    case 16: return intersect_packets<16>(rtc_scene_, rays, hits, n, coherent);
-    case 8: return intersect_packets<8>(rtc_scene_, rays, hits, n, coherent);
-    default: return intersect_packets<4>(rtc_scene_, rays, hits, n, coherent);
-    }
+    with_packet_width(packet_width_, [&](auto w) { intersect_packets<w()>(rtc_scene_, rays, hits, n, coherent); });
 }
 
 bool Scene::intersect(const Ray &ray, SurfaceInteraction &si) const {
@@ -218,11 +225,7 @@ bool Scene::intersect(const Ray &ray, SurfaceInteraction &si) const {
 }
 
 void Scene::occluded16(const Ray *const *rays, int n, bool *occluded) const {
-    switch (packet_width_) {
-    case 16: return occluded_packets<16>(rtc_scene_, rays, n, occluded);
-    case 8: return occluded_packets<8>(rtc_scene_, rays, n, occluded);
-    default: return occluded_packets<4>(rtc_scene_, rays, n, occluded);
-    }
+    with_packet_width(packet_width_, [&](auto w) { occluded_packets<w()>(rtc_scene_, rays, n, occluded); });
 }
 
 bool Scene::occluded(const Ray &ray) const {
