@@ -122,8 +122,7 @@ bool PathIntegrator::begin_vertex(const Scene &scene, Path &path) const {
             }
         return false;
     }
-    SurfaceInteraction &si = path.si;
-    scene.fill(path.hit, ray, si);
+    const SurfaceInteraction &si = path.si;  // filled by Li_batch, with the batch's other hits
     if (const Light *area = si.shape->area_light; area && show_emission) {
         Color Le = area->eval_surface(si, -ray.d);
         if (!is_black(Le)) {
@@ -246,6 +245,12 @@ void PathIntegrator::Li_batch(const Scene &scene, std::span<const Ray> rays, std
                 counters.rays += m;
                 for (int j = 0; j < m; ++j) scene.prefetch(*hs[j]);
             }
+            // The hit records, most of them eight at a time (Shape::HitLanes): the triangles' data, fetched
+            // for the prefetches above, is in cache by now.
+            Shape::HitLanes lanes;
+            for (size_t k = 0; k < live; ++k)
+                if (Path &p = paths[active[k]]; p.hit.valid()) scene.fill_in_lanes(lanes, p.hit, p.ray, p.si);
+            Shape::fill_lanes(lanes);
             size_t shading = 0;
             for (size_t k = 0; k < live; ++k)
                 if (begin_vertex(scene, paths[active[k]])) active[shading++] = active[k];

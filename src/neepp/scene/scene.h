@@ -61,6 +61,13 @@ public:
         shapes_[hit.geom]->fill_interaction(hit.prim, hit.u, hit.v, ray, hit.t, si);
         si.wi = si.to_local(-ray.d);
     }
+    // fill(), or, for a hit that can be, queued in lanes to be filled with seven others (Shape::HitLanes):
+    // si is complete after the eighth, or Shape::fill_lanes.
+    void fill_in_lanes(Shape::HitLanes &lanes, const RayHit &hit, const Ray &ray, SurfaceInteraction &si) const {
+        const Shape &s = *shapes_[hit.geom];
+        if (s.fills_in_lanes()) s.add_lane(lanes, hit.prim, hit.u, hit.v, hit.t, ray.d, si);
+        else fill(hit, ray, si);
+    }
     bool occluded(const Ray &ray) const;
     void occluded16(const Ray *const *rays, int n, bool *occluded) const;  // up to 16 rays, as packets
     // The lanes of the packets trace16 and occluded16 give Embree: the widest this CPU traces natively

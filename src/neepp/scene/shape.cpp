@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <bit>
 
 #include "neepp/math/warp.h"
 
@@ -10,6 +11,10 @@ namespace neepp {
 void Shape::finalize() {
     tangents = !bsdf || bsdf->needs_tangents();
     bsdf_flags = bsdf ? bsdf->flags() : 0;
+    const float all_bits = std::bit_cast<float>(~0u);
+    lane_flip_ = flip_normals ? -0.f : 0.f;
+    lane_vertex_normals_ = (face_normals || normals.empty()) ? 0.f : all_bits;
+    lane_has_uv_ = uvs.empty() ? 0.f : all_bits;
     if (kind == Kind::Sphere) {
         area_ = 4.f * kPi * radius * radius;
         return;
