@@ -1,10 +1,13 @@
 #include "neepp/scene/scene.h"
 
 #include <algorithm>
+#include <cstddef>
 #include <cstdio>
 #include <stdexcept>
 #include <string>
 #include <type_traits>
+
+#include "neepp/math/transpose.h"
 
 namespace neepp {
 namespace {
@@ -52,6 +55,21 @@ void to_embree_packet(const Ray *const *rays, int n, RaysW &r, int *valid) {
     std::fill_n(r.id, W, 0u);
     std::fill_n(r.flags, W, 0u);
     for (int i = 0; i < W; ++i) valid[i] = i < n ? -1 : 0;
+#if defined(__AVX__)
+    // A ray is 8 floats in the order of 8 of the packet's arrays: eight rays are one transpose.
+    if constexpr (W % 8 == 0) {
+        static_assert(sizeof(Ray) == 32 && offsetof(Ray, d) == 12 && offsetof(Ray, tmin) == 24);
+        float *const fields[8] = {r.org_x, r.org_y, r.org_z, r.dir_x, r.dir_y, r.dir_z, r.tnear, r.tfar};
+        for (int b = 0; b < W; b += 8) {
+            __m256 v[8];
+            for (int i = 0; i < 8; ++i)
+                v[i] = _mm256_loadu_ps(reinterpret_cast<const float *>(rays[b + i < n ? b + i : 0]));
+            transpose8(v);
+            for (int k = 0; k < 8; ++k) _mm256_store_ps(fields[k] + b, v[k]);
+        }
+        return;
+    }
+#endif
     for (int i = 0; i < W; ++i) {
         const Ray &ray = *rays[i < n ? i : 0];
         r.org_x[i] = ray.o.x; r.org_y[i] = ray.o.y; r.org_z[i] = ray.o.z;
