@@ -1,11 +1,12 @@
 // Triangle hits filled eight at a time (Shape::HitLanes): the first step of shading in SoA.
 //
-// Why: filling a hit record (interpolated position, face and vertex normals, uv, shading frame, wi) was
-// 790 instructions per sample on bathroom (callgrind, 64², 4.9 hits per sample), 10 % of neepp's own,
-// scalar arithmetic with two square roots and three divisions per hit. Eight hits at a time, one AVX lane
-// each, the same arithmetic is a tenth of the instructions; the cost that stays is moving data between
-// the paths' records (AoS) and the lanes (SoA), done by 8x8 transposes: a triangle's record is three
-// 32-byte rows, a hit record's first 24 floats three more.
+// Why: filling a hit record (interpolated position, face and vertex normals, uv, shading frame, wi) is
+// scalar arithmetic with two square roots and three divisions per hit, and it cost ~1,000 instructions
+// per sample on bathroom (callgrind, 64², 4.9 hits per sample: fill_interaction 790, wi and the call
+// ~220), an eighth of neepp's own. With one AVX lane per hit, the kernel below takes ~300 and queueing the
+// hits into lanes ~250. What stays costly is moving data between the paths' records (AoS) and the lanes
+// (SoA); 8x8 transposes do it: a triangle's record is three rows of 8 floats, and so are the first 24
+// floats of a hit record.
 #include <cstddef>
 
 #include "neepp/scene/shape.h"
@@ -15,16 +16,6 @@
 namespace neepp {
 
 namespace {
-
-// The scalar fill, lane by lane, on CPUs without AVX.
-void fill_one_at_a_time(const Shape::HitLanes &h) {
-    for (int i = 0; i < h.n; ++i) {
-        const Vec3 d(h.dx[i], h.dy[i], h.dz[i]);
-        SurfaceInteraction &si = *h.out[i];
-        h.shape[i]->fill_interaction(h.prim[i], h.b1[i], h.b2[i], Ray{Vec3(), d}, h.t[i], si);
-        si.wi = si.to_local(-d);
-    }
-}
 
 #if defined(__AVX__)
 using V = __m256;
@@ -53,7 +44,11 @@ void fill_kernel(Shape::HitLanes &h) {
                   offsetof(SurfaceInteraction, sh_frame) == 28 && offsetof(SurfaceInteraction, uv) == 64 &&
                   offsetof(SurfaceInteraction, dpdu) == 72 && offsetof(SurfaceInteraction, dpdv) == 84 &&
                   offsetof(SurfaceInteraction, wi) == 96);
-    for (int i = h.n; i < Shape::kHitLanes; ++i) h.tri[i] = h.tri[0];  // unused lanes redo lane 0
+    for (int i = h.n; i < Shape::kHitLanes; ++i) {  // unused lanes redo lane 0 (their results are dropped)
+        h.tri[i] = h.tri[0];
+        h.b1[i] = h.b1[0], h.b2[i] = h.b2[0], h.t[i] = h.t[0], h.dx[i] = h.dx[0], h.dy[i] = h.dy[0], h.dz[i] = h.dz[0];
+        h.flip[i] = h.flip[0], h.vertex_normals[i] = h.vertex_normals[0], h.has_uv[i] = h.has_uv[0];
+    }
     V c[24];
     for (int row = 0; row < 3; ++row) {
         for (int i = 0; i < 8; ++i) c[8 * row + i] = _mm256_load_ps(h.tri[i] + 8 * row);
@@ -124,17 +119,23 @@ void fill_kernel(Shape::HitLanes &h) {
         si.prim_index = h.prim[i];
     }
 }
+#else
+// The scalar fill, lane by lane, on CPUs without AVX.
+void fill_kernel(Shape::HitLanes &h) {
+    for (int i = 0; i < h.n; ++i) {
+        const Vec3 d(h.dx[i], h.dy[i], h.dz[i]);
+        SurfaceInteraction &si = *h.out[i];
+        h.shape[i]->fill_interaction(h.prim[i], h.b1[i], h.b2[i], Ray{Vec3(), d}, h.t[i], si);
+        si.wi = si.to_local(-d);
+    }
+}
 #endif
 
 }  // namespace
 
 void Shape::fill_lanes(HitLanes &h) {
     if (h.n == 0) return;
-#if defined(__AVX__)
     fill_kernel(h);
-#else
-    fill_one_at_a_time(h);
-#endif
     h.n = 0;
 }
 

@@ -1,8 +1,8 @@
 #include "neepp/scene/shape.h"
 
 #include <algorithm>
-#include <cmath>
 #include <bit>
+#include <cmath>
 
 #include "neepp/math/warp.h"
 
