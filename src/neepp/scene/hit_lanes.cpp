@@ -44,6 +44,7 @@ void fill_kernel(Shape::HitLanes &h) {
                   offsetof(SurfaceInteraction, sh_frame) == 28 && offsetof(SurfaceInteraction, uv) == 64 &&
                   offsetof(SurfaceInteraction, dpdu) == 72 && offsetof(SurfaceInteraction, dpdv) == 84 &&
                   offsetof(SurfaceInteraction, wi) == 96);
+    static_assert(Shape::kHitLanes == 8, "one lane per float of an AVX register");
     for (int i = h.n; i < Shape::kHitLanes; ++i) {  // unused lanes redo lane 0 (their results are dropped)
         h.tri[i] = h.tri[0];
         h.b1[i] = h.b1[0], h.b2[i] = h.b2[0], h.t[i] = h.t[0], h.dx[i] = h.dx[0], h.dy[i] = h.dy[0], h.dz[i] = h.dz[0];
