@@ -62,6 +62,21 @@ def test_huge_pages_on_unless_turned_off(neepp_bin, tmp_path, env, expect):
     assert json.loads((tmp_path / "s.json").read_text())["huge_pages"] is expect
 
 
+def test_restarted_process_keeps_its_name(neepp_bin, tmp_path):
+    # The huge-page restart runs the same file again; ps, top and pkill must still see it by its name.
+    if not Path("/proc/self/comm").exists():
+        pytest.skip("no /proc on this system")
+    p = subprocess.Popen([str(neepp_bin), "render", str(DEMO), "-o", str(tmp_path / "n.exr"), "--spp", "100000",
+                          "--time", "20", "--quiet", *SMALL], stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
+    try:
+        time.sleep(1.5)
+        name = Path(f"/proc/{p.pid}/comm").read_text().strip()
+    finally:
+        p.send_signal(signal.SIGINT)
+        p.wait(timeout=60)
+    assert name == Path(neepp_bin).name[:15], name
+
+
 def test_same_seed_same_image_different_seed_different_image(neepp_bin, tmp_path):
     def render(seed, name, threads):
         r = run(neepp_bin, "render", DEMO, "-o", tmp_path / name, "--spp", 2, "--seed", seed, "--threads", threads,

@@ -1,5 +1,6 @@
 #include "neepp/render/huge_pages.h"
 
+#include <climits>
 #include <cstdlib>
 #include <utility>
 #include <unistd.h>
@@ -36,7 +37,12 @@ void restart_with_huge_pages(char **argv) {
     if (tunables.empty()) return;
     const std::string saved = current ? current : "";
     setenv("GLIBC_TUNABLES", tunables.c_str(), 1);
-    execv("/proc/self/exe", argv);  // returns only if the restart failed: go on with 4 KB pages
+    // By the executable's own path, not /proc/self/exe: the kernel names a process after the file it
+    // runs, and ps, top and pkill would otherwise list the render as "exe".
+    char path[PATH_MAX];
+    const ssize_t len = readlink("/proc/self/exe", path, sizeof(path) - 1);
+    path[len > 0 ? len : 0] = '\0';
+    execv(len > 0 ? path : "/proc/self/exe", argv);  // returns only if the restart failed: go on with 4 KB pages
     if (current) setenv("GLIBC_TUNABLES", saved.c_str(), 1);
     else unsetenv("GLIBC_TUNABLES");
 }
