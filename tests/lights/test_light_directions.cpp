@@ -495,7 +495,7 @@ TEST(EnvironmentMapLight, TexelsSitOnMitsubasGrid) {
 
 TEST(ConstantEnvironmentLight, SamplesFollowPdf) {
     ConstantEnvironmentLight light(Color(0.7f, 0.5f, 0.2f));
-    light.set_scene_bounds(BBox{Vec3(-1.f), Vec3(1.f)});
+    light.prepare(BBox{Vec3(-1.f), Vec3(1.f)});
     Vec3 ref(0.5f, -2.f, 1.f);
     expect_samples_match_trace(light, ref, trace_environment(light));
     Chi2Result r = chi2_light(light, ref, trace_environment(light), full_sphere());

@@ -108,7 +108,7 @@ TEST(LightSampler, MixedLightKinds) {
     std::vector<const Light *> lights;
     for (size_t i = 0; i < owned.size(); ++i) {
         owned[i]->index = uint32_t(i);
-        owned[i]->set_scene_bounds(BBox{Vec3(-1.f), Vec3(1.f)});
+        owned[i]->prepare(BBox{Vec3(-1.f), Vec3(1.f)});
         lights.push_back(owned[i].get());
     }
     for (const char *name : {"uniform", "power"}) expect_consistent(*make_light_sampler(name, lights), lights);

@@ -5,6 +5,7 @@
 #include <vector>
 
 #include "neepp/light_selection/factory.h"
+#include "neepp/lights/light_lanes.h"
 #include "neepp/materials/bsdf.h"
 #include "neepp/math/warp.h"
 #include "neepp/sampling/sampler.h"
@@ -88,6 +89,7 @@ struct PathIntegrator::Path {
     bool nee = false;
     SampledLight light;
     Vec2 u_light;
+    LightSample light_sample;  // taken by sample_light, alone or in lanes
     // Next event estimation's shadow query, while its ray waits to be traced with the batch's others.
     ShadowQuery shadow;
     ShadowTest test;
@@ -150,12 +152,22 @@ void PathIntegrator::prefetch_light(const Path &path) const {
     if (path.nee && path.light.light) path.light.light->prefetch_sample(path.u_light, 1);
 }
 
-bool PathIntegrator::begin_direct(Path &path) const {
+void PathIntegrator::sample_light(Path &path, LightSampleLanes &lanes) const {
     const SampledLight &sl = path.light;
-    if (!path.nee || !sl.light || sl.pmf <= 0) return false;
+    path.nee = path.nee && sl.light && sl.pmf > 0;  // from here on: whether there is a sample to use
+    if (!path.nee) return;
+    if (const LightLaneRecord *record = sl.light->lane_record())
+        lanes.add(*record, path.si.p, path.u_light, path.light_sample);
+    else
+        path.light_sample.ds = sl.light->sample_direction(path.si.p, path.u_light, path.light_sample.radiance);
+}
+
+bool PathIntegrator::begin_direct(Path &path) const {
+    if (!path.nee) return false;
+    const SampledLight &sl = path.light;
     const SurfaceInteraction &si = path.si;
-    Color Le;
-    DirectionSample ds = sl.light->sample_direction(si.p, path.u_light, Le);
+    const DirectionSample &ds = path.light_sample.ds;
+    const Color &Le = path.light_sample.radiance;
     if (!(ds.pdf > 0) || is_black(Le)) return false;
     Vec3 wo = si.to_local(ds.d);
     const BSDF &bsdf = *si.shape->bsdf;
@@ -255,6 +267,9 @@ void PathIntegrator::Li_batch(const Scene &scene, std::span<const Ray> rays, std
             for (size_t k = 0; k < live; ++k)
                 if (begin_vertex(scene, paths[active[k]])) active[shading++] = active[k];
             for (size_t k = 0; k < shading; ++k) prefetch_light(paths[active[k]]);
+            LightSampleLanes light_lanes;
+            for (size_t k = 0; k < shading; ++k) sample_light(paths[active[k]], light_lanes);
+            light_lanes.flush();
             // Next event estimation: each policy decides, then the rays it asks for go out as packets.
             size_t querying = 0, tracing = 0;
             for (size_t k = 0; k < shading; ++k)

@@ -10,6 +10,8 @@
 
 namespace neepp {
 
+class LightSampleLanes;
+
 struct PathOptions {
     int max_depth = -1;
     int rr_depth = 5;
@@ -44,10 +46,12 @@ private:
     // Stages of one bounce (see Li_batch). begin_vertex and finish_vertex return false when the path ends.
     bool begin_vertex(const Scene &scene, Path &path) const;
     void prefetch_light(const Path &path) const;
-    // Next event estimation at the vertex: begin_direct samples the light chosen at begin_vertex and forms
+    // Next event estimation at the vertex: sample_light samples the light chosen at begin_vertex, eight at
+    // a time where the light allows it (LightSampleLanes: a rectangle of constant radiance); begin_direct forms
     // the shadow query, its contribution MIS-weighted against BSDF sampling and multiplied by the path
     // throughput so contribution-aware policies see all of it (false: it contributes nothing); decide_direct asks the shadow-ray policy
     // and returns true when a ray must be traced, whose outcome end_direct takes.
+    void sample_light(Path &path, LightSampleLanes &lanes) const;
     bool begin_direct(Path &path) const;
     bool decide_direct(Path &path, RenderCounters &counters) const;
     void end_direct(Path &path, bool occluded) const;

@@ -25,6 +25,18 @@ DirectionSample AreaLight::sample_direction(const Vec3 &ref, Vec2 u, Color &radi
     return ds;
 }
 
+void AreaLight::prepare(const BBox &) {
+    lane_record_ = nullptr;
+    // A parallelogram's sample needs no triangle choice, and with constant radiance no uv: the lane
+    // kernel's case. Its shading normal is its face's (Shape::find_parallelogram checks vertex normals).
+    const std::optional<Shape::Parallelogram> &q = shape_->parallelogram();
+    if (!constant_ || !q || shape_->kind != Shape::Kind::Mesh) return;
+    lane_.p0 = q->p0, lane_.e1 = q->e1, lane_.e2 = q->e2, lane_.n = q->n;
+    lane_.pdf = shape_->pdf_position();
+    lane_.radiance = constant_radiance_;
+    lane_record_ = &lane_;
+}
+
 float AreaLight::pdf_direction(const Vec3 &ref, const DirectionSample &ds) const {
     if (!emits_toward(ds)) return 0.f;
     return shape_->pdf_position() * ds.dist * ds.dist / std::abs(dot(ds.n, ds.d));

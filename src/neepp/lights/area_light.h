@@ -3,6 +3,7 @@
 // interpolated normal has turned away from the viewer does not emit toward it, though its face does.
 #pragma once
 #include "neepp/lights/light.h"
+#include "neepp/lights/light_lanes.h"
 #include "neepp/materials/texture.h"
 #include "neepp/scene/shape.h"
 
@@ -20,6 +21,8 @@ public:
     // The shape's box, a cone around its face and vertex normals, one-sided cosine emission.
     std::optional<LightBounds> bounds() const override;
     const Shape *shape() const { return shape_; }
+    // A parallelogram of constant radiance is sampled in lanes too (lane_record()).
+    void prepare(const BBox &scene_bounds) override;
 
 private:
     // Whether the point of ds emits toward the reference point: it is on the front of its shading
@@ -32,6 +35,7 @@ private:
     // Most emitters are uniform: a light sample then needs neither the point's uv nor a texture lookup.
     bool constant_;
     Color constant_radiance_;
+    LightLaneRecord lane_;
 };
 
 }  // namespace neepp

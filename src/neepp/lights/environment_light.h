@@ -20,7 +20,7 @@ public:
     Color eval_environment(const Vec3 &d) const override;
     Color power() const override;
     bool is_infinite() const override { return true; }
-    void set_scene_bounds(const BBox &b) override { scene_radius_ = std::max(1e-3f, 0.5f * norm(b.extent())); }
+    void prepare(const BBox &b) override { scene_radius_ = std::max(1e-3f, 0.5f * norm(b.extent())); }
 
     // Map between world directions and the map's (u, v) in [0,1)^2 (v = 0 at the top, the +y pole).
     Vec2 direction_to_uv(const Vec3 &d) const;
@@ -69,7 +69,7 @@ public:
     Color eval_environment(const Vec3 &) const override { return radiance_; }
     Color power() const override { return radiance_ * (kPi * 4.f * kPi * scene_radius_ * scene_radius_); }
     bool is_infinite() const override { return true; }
-    void set_scene_bounds(const BBox &b) override { scene_radius_ = std::max(1e-3f, 0.5f * norm(b.extent())); }
+    void prepare(const BBox &b) override { scene_radius_ = std::max(1e-3f, 0.5f * norm(b.extent())); }
 
 private:
     Color radiance_;

@@ -9,6 +9,8 @@
 
 namespace neepp {
 
+struct LightLaneRecord;
+
 // A point on a light as seen from a reference point: where, which way, how likely.
 struct DirectionSample {
     Vec3 p;              // point on the light (for infinite lights: a point far away along d)
@@ -41,12 +43,20 @@ public:
     virtual Color power() const = 0;
     virtual bool is_infinite() const { return false; }
     virtual bool is_delta() const { return false; }
-    // Called once the scene bounds are known (infinite lights need them for power and sample points).
-    virtual void set_scene_bounds(const BBox &) {}
+    // Called once the scene is built: its shapes final, its bounds known (infinite lights need them for
+    // power and sample points; area lights see whether their shape can be sampled in lanes).
+    virtual void prepare(const BBox &scene_bounds) {}
     // Where and which way the light emits, for the light BVH; none for infinite lights (sampled apart).
     virtual std::optional<LightBounds> bounds() const { return std::nullopt; }
 
+    // For lights that integrators may sample in lanes (LightSampleLanes, light_lanes.h) with the same
+    // distribution as sample_direction: what the lane kernel reads. Null: sample_direction only.
+    const LightLaneRecord *lane_record() const { return lane_record_; }
+
     uint32_t index = 0;  // position in Scene::lights, for light samplers' tables
+
+protected:
+    const LightLaneRecord *lane_record_ = nullptr;
 };
 
 using LightPtr = std::unique_ptr<Light>;

@@ -11,6 +11,7 @@
 
 #include "neepp/scene/shape.h"
 
+#include "neepp/math/lanes.h"
 #include "neepp/math/transpose.h"
 
 namespace neepp {
@@ -18,22 +19,8 @@ namespace neepp {
 namespace {
 
 #if defined(__AVX__)
-using V = __m256;
+using namespace lanes;
 
-inline V add(V a, V b) { return _mm256_add_ps(a, b); }
-inline V sub(V a, V b) { return _mm256_sub_ps(a, b); }
-inline V mul(V a, V b) { return _mm256_mul_ps(a, b); }
-inline V mul_add(V a, V b, V c) {
-#if defined(__FMA__)
-    return _mm256_fmadd_ps(a, b, c);
-#else
-    return add(mul(a, b), c);
-#endif
-}
-inline V select(V mask, V a, V b) { return _mm256_blendv_ps(b, a, mask); }  // a where mask's sign bit is set
-inline V negate(V a) { return _mm256_xor_ps(a, _mm256_set1_ps(-0.f)); }
-inline V flip_sign(V a, V sign) { return _mm256_xor_ps(a, sign); }           // sign: -0 (flip) or +0
-inline V dot(V ax, V ay, V az, V bx, V by, V bz) { return mul_add(ax, bx, mul_add(ay, by, mul(az, bz))); }
 // b0 a0 + b1 a1 + b2 a2: one coordinate interpolated across the triangle's corners.
 inline V interpolate(V a0, V a1, V a2, V b0, V b1, V b2) { return mul_add(a0, b0, mul_add(a1, b1, mul(a2, b2))); }
 

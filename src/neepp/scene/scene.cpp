@@ -208,7 +208,7 @@ void Scene::build() {
     if (!bounds_.valid()) bounds_ = BBox{Vec3(-1.f), Vec3(1.f)};
     infinite_lights_.clear();
     for (auto &l : lights_) {
-        l->set_scene_bounds(bounds_);
+        l->prepare(bounds_);
         if (l->is_infinite()) infinite_lights_.push_back(l.get());
     }
 }

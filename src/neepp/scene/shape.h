@@ -95,6 +95,19 @@ struct Shape {
     // whether it is traced alone or with others.
     static void fill_lanes(HitLanes &h);
 
+    // A mesh of two triangles forming a parallelogram (Mitsuba's `rectangle`, a quad from a file) is
+    // sampled as one: p = corner + u.x e1 + u.y e2, with no triangle to choose. Its uv is affine in
+    // (u.x, u.y) when the corners' uvs form a parallelogram too (uv_affine), and then is what a ray hit
+    // at p interpolates.
+    struct Parallelogram {
+        Vec3 p0, e1, e2, n;
+        Vec2 uv0, duv1, duv2;
+        bool uv_affine = false;
+    };
+    // This mesh as a parallelogram (its normal flipped if asked), if it is one: light samples in lanes
+    // (LightSampleLanes) take it from here.
+    const std::optional<Parallelogram> &parallelogram() const { return parallelogram_; }
+
     // Cache prefetch of what fill_interaction(prim) reads: its triangle's record, two cache lines.
     // Inline: it runs once per ray, from the integrator's batch loop.
     void prefetch(uint32_t prim) const {
@@ -123,15 +136,6 @@ private:
         Vec3 p0, e1, e2, n;
     };
     SamplingTriangle sampling_triangle(size_t tri) const;
-    // A mesh of two triangles forming a parallelogram (Mitsuba's `rectangle`, a quad from a file) is
-    // sampled as one: p = corner + u.x e1 + u.y e2, with no triangle to choose. Its uv is affine in
-    // (u.x, u.y) when the corners' uvs form a parallelogram too (uv_affine), and then is what a ray hit
-    // at p interpolates.
-    struct Parallelogram {
-        Vec3 p0, e1, e2, n;
-        Vec2 uv0, duv1, duv2;
-        bool uv_affine = false;
-    };
     std::optional<Parallelogram> find_parallelogram() const;
 
     float lane_flip_ = 0, lane_vertex_normals_ = 0, lane_has_uv_ = 0;  // HitLanes' masks, set by finalize()
