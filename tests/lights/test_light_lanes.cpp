@@ -64,7 +64,9 @@ TEST(LightLanes, SameSamplesAsOneAtATime) {
                 EXPECT_FALSE(got.delta);
                 // Validity agrees (away from the light's plane, where rounding could tip it) ...
                 const float cos_light = std::abs(dot(want.n, want.d));
-                if (cos_light > 1e-4f) ASSERT_EQ(got.pdf > 0, want.pdf > 0) << "lane " << i << " of " << count;
+                if (cos_light > 1e-4f) {
+                    ASSERT_EQ(got.pdf > 0, want.pdf > 0) << "lane " << i << " of " << count;
+                }
                 // ... and so do the density and radiance of a valid sample; an invalid one carries neither.
                 if (want.pdf > 0 && got.pdf > 0) {
                     EXPECT_NEAR(got.pdf, want.pdf, 1e-4f * want.pdf);
