@@ -14,6 +14,9 @@ public:
     AreaLight(const Shape *shape, TexturePtr radiance)
         : shape_(shape), radiance_(std::move(radiance)), constant_(radiance_->is_constant()),
           constant_radiance_(radiance_->mean()) {}
+    // Not copyable: lane_record() points into the light itself.
+    AreaLight(const AreaLight &) = delete;
+    AreaLight &operator=(const AreaLight &) = delete;
     DirectionSample sample_direction(const Vec3 &ref, Vec2 u, Color &radiance) const override;
     float pdf_direction(const Vec3 &ref, const DirectionSample &ds) const override;
     Color eval_surface(const SurfaceInteraction &si, const Vec3 &w) const override;
