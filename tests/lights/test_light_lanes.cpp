@@ -27,6 +27,7 @@ void expect_near(const Vec3 &a, const Vec3 &b, float tol, const char *what) {
 }
 
 TEST(LightLanes, SameSamplesAsOneAtATime) {
+    if (!LightSampleLanes::kEnabled) GTEST_SKIP() << "no AVX: lights are sampled one at a time";
     // Two lights of different size, tilt, radiance and side, mixed in the same lanes; no edge has a zero
     // coordinate, so that each of u and v moves every coordinate of the point.
     Shape a = make_parallelogram(Vec3(-1.f, 2.f, -0.5f), Vec3(2.f, 0.4f, -0.3f), Vec3(0.2f, 0.3f, 1.f), false);
@@ -86,6 +87,7 @@ TEST(LightLanes, SameSamplesAsOneAtATime) {
 }
 
 TEST(LightLanes, PointOnTheLightIsInvalid) {
+    if (!LightSampleLanes::kEnabled) GTEST_SKIP() << "no AVX: lights are sampled one at a time";
     Shape s = make_parallelogram(Vec3(0.f), Vec3(1.f, 0.f, 0.f), Vec3(0.f, 1.f, 0.f), false);
     AreaLight light(&s, constant_texture(1.f));
     light.prepare(BBox{Vec3(-1.f), Vec3(1.f)});

@@ -30,7 +30,7 @@ void AreaLight::prepare(const BBox &) {
     // A parallelogram's sample needs no triangle choice, and with constant radiance no uv: the lane
     // kernel's case. Its shading normal is its face's (Shape::find_parallelogram checks vertex normals).
     const std::optional<Shape::Parallelogram> &q = shape_->parallelogram();
-    if (!constant_ || !q || shape_->kind != Shape::Kind::Mesh) return;
+    if (!LightSampleLanes::kEnabled || !constant_ || !q || shape_->kind != Shape::Kind::Mesh) return;
     lane_.p0 = q->p0, lane_.e1 = q->e1, lane_.e2 = q->e2, lane_.n = q->n;
     lane_.pdf = shape_->pdf_position();
     lane_.radiance = constant_radiance_;

@@ -5,8 +5,6 @@
 
 namespace neepp {
 
-namespace {
-
 // What the transposes assume: a record is two rows of 8 floats (p0, e1, e2.xy | e2.z, n, pdf, radiance),
 // and a LightSample's first 16 floats are p, n, ns, d, dist, pdf, delta (false: all bits zero), radiance.x.
 static_assert(offsetof(LightLaneRecord, n) == 36 && offsetof(LightLaneRecord, pdf) == 48 &&
@@ -17,6 +15,7 @@ static_assert(offsetof(DirectionSample, n) == 12 && offsetof(DirectionSample, ns
               offsetof(LightSample, radiance) == 60);
 
 #if defined(__AVX__)
+namespace {
 using namespace lanes;
 
 void sample_kernel(const float *rx, const float *ry, const float *rz, const float *ux, const float *uy,
@@ -63,29 +62,8 @@ void sample_kernel(const float *rx, const float *ry, const float *rz, const floa
         out[i]->radiance.y = radiance_y[i], out[i]->radiance.z = radiance_z[i];
     }
 }
-#else
-// The same arithmetic, lane by lane, on CPUs without AVX.
-void sample_kernel(const float *rx, const float *ry, const float *rz, const float *ux, const float *uy,
-                   const LightLaneRecord *const *light, LightSample *const *out, int n) {
-    for (int i = 0; i < n; ++i) {
-        const LightLaneRecord &l = *light[i];
-        DirectionSample &ds = out[i]->ds;
-        ds = DirectionSample{};
-        ds.p = l.p0 + l.e1 * ux[i] + l.e2 * uy[i];
-        ds.n = ds.ns = l.n;
-        const Vec3 d = ds.p - Vec3(rx[i], ry[i], rz[i]);
-        const float dist2 = squared_norm(d);
-        ds.dist = std::sqrt(dist2);
-        ds.d = d * (1.f / ds.dist);
-        const float cos_light = dot(l.n, ds.d);
-        const bool valid = cos_light < 0.f && dist2 > 0.f;
-        ds.pdf = valid ? l.pdf * dist2 / std::abs(cos_light) : 0.f;
-        out[i]->radiance = valid ? l.radiance : Color(0.f);
-    }
-}
-#endif
-
 }  // namespace
+
 
 void LightSampleLanes::flush() {
     if (n_ == 0) return;
@@ -94,5 +72,8 @@ void LightSampleLanes::flush() {
     sample_kernel(rx_, ry_, rz_, ux_, uy_, light_, out_, n_);
     n_ = 0;
 }
+#else
+void LightSampleLanes::flush() { n_ = 0; }  // nothing is queued without AVX (kEnabled)
+#endif
 
 }  // namespace neepp

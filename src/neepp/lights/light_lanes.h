@@ -31,6 +31,12 @@ struct LightSample {
 class LightSampleLanes {
 public:
     static constexpr int kLanes = 8;
+    // Without AVX there is no kernel: lights have no lane record, and are sampled by sample_direction.
+#if defined(__AVX__)
+    static constexpr bool kEnabled = true;
+#else
+    static constexpr bool kEnabled = false;
+#endif
 
     // Queues a sample of light from ref with u, written to out when the lanes are filled: on the eighth,
     // or at flush().
