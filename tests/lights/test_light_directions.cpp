@@ -493,6 +493,29 @@ TEST(EnvironmentMapLight, TexelsSitOnMitsubasGrid) {
         }
 }
 
+TEST(EnvironmentMapLight, LookupsBlendTheirFourTexels) {
+    // Between texel centres, with unequal weights in u and v (so no two corners could trade places
+    // unseen), the last column blending with the first. Maps within half's range keep half texels, those
+    // beyond keep floats: both are checked, each against the image's own texels.
+    for (const float gain : {1.f, 1e5f}) {
+        Image img = make_env_image();
+        for (float &v : img.data) v *= gain;
+        EnvironmentMapLight light(img, Transform(), 1.f);
+        const float fx = 0.3f, fy = 0.6f;
+        for (int j = 1; j < kEnvH - 2; ++j)
+            for (int i = 0; i < kEnvW; ++i) {
+                const int i1 = (i + 1) % kEnvW;
+                const Vec3 d = light.uv_to_direction({(float(i) + fx) / kEnvW, (float(j) + fy) / (kEnvH - 1)});
+                const Color expected = img.rgb(i, j) * ((1 - fx) * (1 - fy)) + img.rgb(i1, j) * (fx * (1 - fy)) +
+                                       img.rgb(i, j + 1) * ((1 - fx) * fy) + img.rgb(i1, j + 1) * (fx * fy);
+                const Color got = light.eval_environment(d);
+                EXPECT_TRUE(near_rel(got, expected, 2e-3f, 1e-4f * gain))
+                    << "gain " << gain << ", between texels " << i << "," << j << ": (" << got.x << "," << got.y
+                    << "," << got.z << ") vs (" << expected.x << "," << expected.y << "," << expected.z << ")";
+            }
+    }
+}
+
 TEST(ConstantEnvironmentLight, SamplesFollowPdf) {
     ConstantEnvironmentLight light(Color(0.7f, 0.5f, 0.2f));
     light.prepare(BBox{Vec3(-1.f), Vec3(1.f)});

@@ -28,6 +28,27 @@ TEST(Trig, SinCosQuarterWithinAnUlpOrTwo) {
     EXPECT_EQ(sincos_quarter(0.f).cos, 1.f);
 }
 
+TEST(Trig, SinCosTurnsMatchesDoublePrecision) {
+    // Every quadrant and its boundaries, negative turns and several periods. An angle's sine near a
+    // zero is judged by absolute error: the float t itself is only known to its own spacing.
+    double worst = 0;
+    constexpr int kSteps = 1 << 20;
+    for (int i = 0; i <= kSteps; ++i) {
+        const float t = float(-2.0 + 5.0 * double(i) / kSteps);
+        const SinCos r = sincos_turns(t);
+        const double a = 2 * M_PI * double(t);
+        worst = std::max({worst, std::abs(r.sin - std::sin(a)), std::abs(r.cos - std::cos(a))});
+    }
+    EXPECT_LE(worst * 0x1p24, 3.0);  // absolute error, in units of 2^-24
+    // Exact at the quarter turns, where the reduction leaves nothing.
+    for (float t : {0.f, 0.25f, 0.5f, 0.75f, 1.f, -0.25f}) {
+        const SinCos r = sincos_turns(t);
+        EXPECT_EQ(std::abs(r.sin) + std::abs(r.cos), 1.f) << t;
+        EXPECT_EQ(r.sin, float(std::round(std::sin(2 * M_PI * t)))) << t;
+        EXPECT_EQ(r.cos, float(std::round(std::cos(2 * M_PI * t)))) << t;
+    }
+}
+
 TEST(Trig, ConcentricDiskMatchesItsAngleForm) {
     constexpr int n = 257;
     for (int i = 0; i < n; ++i)

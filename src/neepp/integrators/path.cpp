@@ -88,7 +88,7 @@ struct PathIntegrator::Path {
     LightSampleContext ctx;
     bool nee = false;
     SampledLight light;
-    Vec2 u_light;
+    LightSampleStart light_start;  // begun by begin_light, from the light's variates
     LightSample light_sample;  // taken by sample_light, alone or in lanes
     // Next event estimation's shadow query, while its ray waits to be traced with the batch's others.
     ShadowQuery shadow;
@@ -142,14 +142,14 @@ bool PathIntegrator::begin_vertex(const Scene &scene, Path &path) const {
     path.nee = options_.nee && (si.shape->bsdf_flags & BSDFSmooth);
     if (path.nee) {
         path.light = light_sampler_->sample(path.ctx, path.sampler->next_1d());
-        path.u_light = path.sampler->next_2d();
-        if (path.light.light) path.light.light->prefetch_sample(path.u_light, 0);
+        path.light_start.u = path.sampler->next_2d();
+        if (path.light.light) path.light.light->prefetch_sample(path.light_start.u);
     }
     return true;
 }
 
-void PathIntegrator::prefetch_light(const Path &path) const {
-    if (path.nee && path.light.light) path.light.light->prefetch_sample(path.u_light, 1);
+void PathIntegrator::begin_light(Path &path) const {
+    if (path.nee && path.light.light) path.light_start = path.light.light->begin_sample(path.light_start.u);
 }
 
 void PathIntegrator::sample_light(Path &path, LightSampleLanes &lanes) const {
@@ -157,9 +157,9 @@ void PathIntegrator::sample_light(Path &path, LightSampleLanes &lanes) const {
     path.nee = path.nee && sl.light && sl.pmf > 0;  // from here on: whether there is a sample to use
     if (!path.nee) return;
     if (const LightLaneRecord *record = sl.light->lane_record())
-        lanes.add(*record, path.si.p, path.u_light, path.light_sample);
+        lanes.add(*record, path.si.p, path.light_start.u, path.light_sample);
     else
-        path.light_sample.ds = sl.light->sample_direction(path.si.p, path.u_light, path.light_sample.radiance);
+        path.light_sample.ds = sl.light->finish_sample(path.si.p, path.light_start, path.light_sample.radiance);
 }
 
 bool PathIntegrator::begin_direct(Path &path) const {
@@ -266,7 +266,7 @@ void PathIntegrator::Li_batch(const Scene &scene, std::span<const Ray> rays, std
             size_t shading = 0;
             for (size_t k = 0; k < live; ++k)
                 if (begin_vertex(scene, paths[active[k]])) active[shading++] = active[k];
-            for (size_t k = 0; k < shading; ++k) prefetch_light(paths[active[k]]);
+            for (size_t k = 0; k < shading; ++k) begin_light(paths[active[k]]);
             LightSampleLanes light_lanes;
             for (size_t k = 0; k < shading; ++k) sample_light(paths[active[k]], light_lanes);
             light_lanes.flush();

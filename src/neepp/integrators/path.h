@@ -45,12 +45,13 @@ private:
     struct Path;  // one path's state between stages
     // Stages of one bounce (see Li_batch). begin_vertex and finish_vertex return false when the path ends.
     bool begin_vertex(const Scene &scene, Path &path) const;
-    void prefetch_light(const Path &path) const;
-    // Next event estimation at the vertex: sample_light samples the light chosen at begin_vertex, eight at
-    // a time where the light allows it (LightSampleLanes: a rectangle of constant radiance); begin_direct forms
+    // Next event estimation at the vertex: begin_light and sample_light sample the light chosen at
+    // begin_vertex in two steps (Light::begin_sample, finish_sample), the second eight at a time where the
+    // light allows it (LightSampleLanes: a rectangle of constant radiance); begin_direct forms
     // the shadow query, its contribution MIS-weighted against BSDF sampling and multiplied by the path
     // throughput so contribution-aware policies see all of it (false: it contributes nothing); decide_direct asks the shadow-ray policy
     // and returns true when a ray must be traced, whose outcome end_direct takes.
+    void begin_light(Path &path) const;
     void sample_light(Path &path, LightSampleLanes &lanes) const;
     bool begin_direct(Path &path) const;
     bool decide_direct(Path &path, RenderCounters &counters) const;

@@ -3,10 +3,12 @@
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
+#include <immintrin.h>
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 #include <tbb/parallel_reduce.h>
 #include <Imath/half.h>
+#include "neepp/math/trig.h"
 #include "neepp/math/warp.h"
 
 namespace neepp {
@@ -39,7 +41,7 @@ EnvironmentMapLight::EnvironmentMapLight(Image image, const Transform &to_world,
         [](float a, float b) { return std::max(a, b); });
     // Half floats when every texel fits: half the memory and cache traffic of the lookups.
     const bool halves = std::isfinite(largest) && largest <= float(HALF_MAX);
-    if (halves) half_.resize(3 * size_t(w) * h);
+    if (halves) half_.resize(3 * size_t(w) * h + 1);  // + 1: lookup() loads a texel as four halves
     else float_.resize(3 * size_t(w) * h);
     rows(h, [&](int y) {
         for (int x = 0; x < w; ++x) {
@@ -127,11 +129,10 @@ Vec2 EnvironmentMapLight::direction_to_uv(const Vec3 &d_world) const {
 }
 
 Vec3 EnvironmentMapLight::uv_to_direction(Vec2 uv, float *sin_theta) const {
-    float st, ct, sp, cp;
-    sincosf(uv.y * kPi, &st, &ct);
-    sincosf(uv.x * 2.f * kPi, &sp, &cp);
-    if (sin_theta) *sin_theta = st;
-    return normalize(to_world_.vector(Vec3(st * sp, ct, -st * cp)));
+    // theta = pi v and phi = 2 pi u, in turns: v / 2 and u.
+    const SinCos t = sincos_turns(0.5f * uv.y), p = sincos_turns(uv.x);
+    if (sin_theta) *sin_theta = t.sin;
+    return normalize(to_world_.vector(Vec3(t.sin * p.sin, t.cos, -t.sin * p.cos)));
 }
 
 Color EnvironmentMapLight::texel(size_t index) const {
@@ -159,7 +160,23 @@ EnvironmentMapLight::Bilinear EnvironmentMapLight::bilinear(Vec2 uv) const {
 }
 
 Color EnvironmentMapLight::lookup(Vec2 uv) const {
-    return bilinear(uv).blend([&](size_t i) { return texel(i); });
+    const Bilinear b = bilinear(uv);
+#if defined(__F16C__)
+    // Each texel converted by one instruction, its three halves and the next one's first (the padding
+    // half past the last texel keeps that load inside the buffer), and blended in one register.
+    if (!half_.empty()) {
+        auto at = [&](size_t i, float w) {
+            return _mm_mul_ps(_mm_cvtph_ps(_mm_loadl_epi64(reinterpret_cast<const __m128i *>(&half_[3 * i]))),
+                              _mm_set1_ps(w));
+        };
+        const __m128 c = _mm_add_ps(_mm_add_ps(at(b.i00, b.w00), at(b.i10, b.w10)),
+                                    _mm_add_ps(at(b.i01, b.w01), at(b.i11, b.w11)));
+        alignas(16) float out[4];
+        _mm_store_ps(out, c);
+        return Color(out[0], out[1], out[2]);
+    }
+#endif
+    return b.blend([&](size_t i) { return texel(i); });
 }
 
 Color EnvironmentMapLight::eval_environment(const Vec3 &d) const { return lookup(direction_to_uv(d)) * scale_; }
@@ -173,26 +190,24 @@ Vec2 EnvironmentMapLight::sample_uv(Vec2 u, float &pdf_uv) const {
     return {(float(cell % w) + offset.x) / float(w), (float(cell / w) + offset.y) / float(h)};
 }
 
-void EnvironmentMapLight::prefetch_sample(Vec2 u, int level) const {
-    if (level == 0) {
-        cells_.prefetch(u);
-        return;
-    }
-    float pdf_uv;
-    const Vec2 uv = sample_uv(u, pdf_uv);
-    // The two texel rows of lookup(uv)'s bilinear footprint (each pair of texels is 12 bytes).
-    const int x = std::min(int(uv.x * float(width_)), width_ - 1);
-    const int y = std::min(int(uv.y * float(height_ - 1)), height_ - 1), y1 = std::min(y + 1, height_ - 1);
+LightSampleStart EnvironmentMapLight::begin_sample(Vec2 u) const {
+    LightSampleStart start{u};
+    start.point = sample_uv(u, start.density);
+    // The two texel rows of lookup(uv)'s bilinear footprint, which finish_sample reads.
+    const int x = std::min(int(start.point.x * float(width_)), width_ - 1);
+    const int y = std::min(int(start.point.y * float(height_ - 1)), height_ - 1), y1 = std::min(y + 1, height_ - 1);
     for (int row : {y, y1}) {
         const size_t i = 3 * (size_t(row) * width_ + x);
         if (!half_.empty()) __builtin_prefetch(&half_[i]);
         else __builtin_prefetch(&float_[i]);
     }
+    return start;
 }
 
-DirectionSample EnvironmentMapLight::sample_direction(const Vec3 &ref, Vec2 u, Color &radiance) const {
-    float pdf_uv;
-    const Vec2 uv = sample_uv(u, pdf_uv);
+DirectionSample EnvironmentMapLight::finish_sample(const Vec3 &ref, const LightSampleStart &start,
+                                                   Color &radiance) const {
+    const Vec2 uv = start.point;
+    const float pdf_uv = start.density;
     DirectionSample ds;
     radiance = Color(0.f);
     if (pdf_uv <= 0) return ds;
@@ -205,6 +220,10 @@ DirectionSample EnvironmentMapLight::sample_direction(const Vec3 &ref, Vec2 u, C
     ds.p = ref + ds.d * (4.f * scene_radius_);
     radiance = lookup(uv) * scale_;
     return ds;
+}
+
+DirectionSample EnvironmentMapLight::sample_direction(const Vec3 &ref, Vec2 u, Color &radiance) const {
+    return finish_sample(ref, begin_sample(u), radiance);
 }
 
 float EnvironmentMapLight::pdf_direction(const Vec3 &, const DirectionSample &ds) const {

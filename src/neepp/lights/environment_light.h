@@ -16,7 +16,9 @@ public:
     EnvironmentMapLight(Image image, const Transform &to_world, float scale);
     DirectionSample sample_direction(const Vec3 &ref, Vec2 u, Color &radiance) const override;
     float pdf_direction(const Vec3 &ref, const DirectionSample &ds) const override;
-    void prefetch_sample(Vec2 u, int level) const override;
+    void prefetch_sample(Vec2 u) const override { cells_.prefetch(u); }
+    LightSampleStart begin_sample(Vec2 u) const override;
+    DirectionSample finish_sample(const Vec3 &ref, const LightSampleStart &start, Color &radiance) const override;
     Color eval_environment(const Vec3 &d) const override;
     Color power() const override;
     bool is_infinite() const override { return true; }

@@ -22,17 +22,30 @@ struct DirectionSample {
     bool delta = false;  // sampled from a delta distribution (point light): not reachable by BSDF sampling
 };
 
+// A light sample begun by Light::begin_sample, for finish_sample: its variates, and what the light
+// computed from them alone (an environment map: the map point and its density in uv).
+struct LightSampleStart {
+    Vec2 u;
+    Vec2 point{0.f, 0.f};
+    float density = 0;
+};
+
 class Light {
 public:
     virtual ~Light() = default;
     // Samples a direction toward the light from ref. Returns the emitted radiance arriving at ref along
     // -d, ignoring occlusion, via `radiance` (zero when the sample is invalid, e.g. the back of an area light).
     virtual DirectionSample sample_direction(const Vec3 &ref, Vec2 u, Color &radiance) const = 0;
-    // Cache prefetch of what sample_direction(ref, u) will read, in dependency order: level 0 what u
-    // alone locates, level 1 what level 0 brought in locates. A hint for batched integrators, which
-    // issue it for many paths before sampling any (a light sample is otherwise a chain of cache misses);
-    // it never changes a result.
-    virtual void prefetch_sample(Vec2 u, int level) const {}
+    // Light samples in steps, for batched integrators, which take each step for many paths before the
+    // next (a light sample is otherwise a chain of cache misses):
+    //   prefetch_sample(u)            cache prefetch of what u alone locates (a hint; never changes a result);
+    //   begin_sample(u)               the work u alone determines, and a prefetch of what finishing reads;
+    //   finish_sample(ref, start)     the rest: finish_sample(ref, begin_sample(u)) is sample_direction(ref, u).
+    virtual void prefetch_sample(Vec2 u) const {}
+    virtual LightSampleStart begin_sample(Vec2 u) const { return {u}; }
+    virtual DirectionSample finish_sample(const Vec3 &ref, const LightSampleStart &start, Color &radiance) const {
+        return sample_direction(ref, start.u, radiance);
+    }
     // Solid-angle density with which sample_direction would have produced ds from ref (0 for delta lights).
     virtual float pdf_direction(const Vec3 &ref, const DirectionSample &ds) const = 0;
     // Radiance leaving a point of an area light toward direction w (world, pointing away from the light).

@@ -71,9 +71,9 @@ std::pair<Vec3, float> MicrofacetDistribution::sample_projected_area(Vec2 u) con
     // Sample D(m) cos(theta_m): azimuth first (shared by both distributions), then elevation.
     float sin_phi, cos_phi, alpha_2;
     if (alpha_u_ == alpha_v_) {
-        float phi = 2.f * kPi * u.y;
-        sin_phi = std::sin(phi);
-        cos_phi = std::cos(phi);
+        const SinCos phi = sincos_turns(u.y);
+        sin_phi = phi.sin;
+        cos_phi = phi.cos;
         alpha_2 = alpha_u_ * alpha_u_;
     } else {
         float ratio = alpha_v_ / alpha_u_, tmp = ratio * std::tan(2.f * kPi * u.y);

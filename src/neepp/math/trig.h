@@ -4,6 +4,7 @@
 // error is below 2e-9 (sin) and 2e-10 (cos), so the result is within about 1 ulp of the exact value
 // (tests/math/test_trig.cpp checks it against double precision).
 #pragma once
+#include <cmath>
 
 namespace neepp {
 
@@ -26,6 +27,22 @@ constexpr SinCos sincos_quarter(float x) {
     c = c * x2 - 0.5f;
     c = c * x2 + 1.f;
     return {s, c};
+}
+
+// Sine and cosine of 2π·t, an angle given in turns (as samplers produce them: a variate in [0, 1) times
+// 2π), for |t| up to 2^20. The reduction to [-1/8, 1/8] turn is exact in turns: q/4 is a multiple of the
+// float spacing at t and lies within 1/8 of it, so t - q/4 needs no rounding. What is left, times 2π,
+// falls in sincos_quarter's range, and the quadrant swaps and negates. A tenth of libm's sincosf's
+// instructions (which reduces any argument in radians), within an ulp or two of it.
+inline SinCos sincos_turns(float t) {
+    const float q = std::nearbyint(4.f * t);
+    const SinCos r = sincos_quarter((t - 0.25f * q) * (2.f * 3.14159265358979323846f));
+    switch (int(q) & 3) {
+        case 0: return r;
+        case 1: return {r.cos, -r.sin};
+        case 2: return {-r.sin, -r.cos};
+        default: return {-r.cos, r.sin};
+    }
 }
 
 }  // namespace neepp

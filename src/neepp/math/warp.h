@@ -26,21 +26,24 @@ inline Vec3 square_to_cosine_hemisphere(Vec2 u) {
 inline float square_to_cosine_hemisphere_pdf(const Vec3 &v) { return v.z > 0 ? v.z * kInvPi : 0.f; }
 
 inline Vec3 square_to_uniform_sphere(Vec2 u) {
-    float z = 1.f - 2.f * u.y, r = safe_sqrt(1.f - z * z), phi = 2.f * kPi * u.x;
-    return {r * std::cos(phi), r * std::sin(phi), z};
+    const float z = 1.f - 2.f * u.y, r = safe_sqrt(1.f - z * z);
+    const SinCos phi = sincos_turns(u.x);
+    return {r * phi.cos, r * phi.sin, z};
 }
 inline float square_to_uniform_sphere_pdf() { return kInv4Pi; }
 
 inline Vec3 square_to_uniform_hemisphere(Vec2 u) {
-    float z = u.y, r = safe_sqrt(1.f - z * z), phi = 2.f * kPi * u.x;
-    return {r * std::cos(phi), r * std::sin(phi), z};
+    const float z = u.y, r = safe_sqrt(1.f - z * z);
+    const SinCos phi = sincos_turns(u.x);
+    return {r * phi.cos, r * phi.sin, z};
 }
 inline float square_to_uniform_hemisphere_pdf() { return kInv2Pi; }
 
 // Uniform direction within a cone of half-angle acos(cos_max) around +z.
 inline Vec3 square_to_uniform_cone(Vec2 u, float cos_max) {
-    float cos_t = (1.f - u.y) + u.y * cos_max, sin_t = safe_sqrt(1.f - cos_t * cos_t), phi = 2.f * kPi * u.x;
-    return {sin_t * std::cos(phi), sin_t * std::sin(phi), cos_t};
+    const float cos_t = (1.f - u.y) + u.y * cos_max, sin_t = safe_sqrt(1.f - cos_t * cos_t);
+    const SinCos phi = sincos_turns(u.x);
+    return {sin_t * phi.cos, sin_t * phi.sin, cos_t};
 }
 inline float square_to_uniform_cone_pdf(float cos_max) { return 1.f / (2.f * kPi * (1.f - cos_max)); }
 
