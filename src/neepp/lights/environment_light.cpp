@@ -14,7 +14,7 @@
 namespace neepp {
 
 EnvironmentMapLight::EnvironmentMapLight(Image image, const Transform &to_world, float scale)
-    : to_world_(to_world), scale_(scale) {
+    : to_world_(to_world), to_local_(to_world.inverse()), scale_(scale) {
     width_ = image.width, height_ = image.height;
     if (image.width < 2 || image.height < 2) throw std::runtime_error("envmap: image too small");
     const int w = width_, h = height_;
@@ -120,7 +120,7 @@ EnvironmentMapLight::EnvironmentMapLight(Image image, const Transform &to_world,
 }
 
 Vec2 EnvironmentMapLight::direction_to_uv(const Vec3 &d_world) const {
-    Vec3 v = normalize(to_world_.inverse().vector(d_world));
+    Vec3 v = normalize(to_local_.vector(d_world));
     float u = std::atan2(v.x, -v.z) * kInv2Pi;
     if (u < 0) u += 1.f;
     // atan2 keeps precision near the poles, where acos(y) loses it.

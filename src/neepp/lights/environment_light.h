@@ -54,7 +54,7 @@ private:
     int width_ = 0, height_ = 0;
     std::vector<uint16_t> half_;
     std::vector<float> float_;
-    Transform to_world_;
+    Transform to_world_, to_local_;  // to_local_: its inverse, kept rather than built per lookup
     float scale_;
     static constexpr int kMaxSampleWidth = 1024;
     AliasTable cells_;  // sampling cells (texel cells merged down to at most 1024x512), ∝ luminance × sin(theta)

@@ -108,12 +108,6 @@ Vec3 Transform::point(const Vec3 &p) const {
     return w == 1.f ? r : r / w;
 }
 
-Vec3 Transform::vector(const Vec3 &v) const {
-    const auto &a = matrix.m;
-    return {a[0][0] * v.x + a[0][1] * v.y + a[0][2] * v.z, a[1][0] * v.x + a[1][1] * v.y + a[1][2] * v.z,
-            a[2][0] * v.x + a[2][1] * v.y + a[2][2] * v.z};
-}
-
 Vec3 Transform::normal(const Vec3 &n) const {
     const auto &a = inverse_matrix.m;
     return {a[0][0] * n.x + a[1][0] * n.y + a[2][0] * n.z, a[0][1] * n.x + a[1][1] * n.y + a[2][1] * n.z,

@@ -29,7 +29,12 @@ struct Transform {
     Transform inverse() const { return {inverse_matrix, matrix}; }
 
     Vec3 point(const Vec3 &p) const;
-    Vec3 vector(const Vec3 &v) const;
+    // Inline: the environment map turns every direction it samples or looks up.
+    Vec3 vector(const Vec3 &v) const {
+        const auto &a = matrix.m;
+        return {a[0][0] * v.x + a[0][1] * v.y + a[0][2] * v.z, a[1][0] * v.x + a[1][1] * v.y + a[1][2] * v.z,
+                a[2][0] * v.x + a[2][1] * v.y + a[2][2] * v.z};
+    }
     // Normals transform by the inverse transpose.
     Vec3 normal(const Vec3 &n) const;
     // Whether the transform flips orientation (negative determinant of the linear part).
