@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <stdexcept>
 
+#include "neepp/math/select.h"
+
 namespace neepp {
 
 Distribution1D::Distribution1D(std::vector<float> weights) : weights_(std::move(weights)) {
@@ -115,21 +117,17 @@ AliasTable::AliasTable(const std::vector<float> &weights) {
 
 uint32_t AliasTable::sample(Vec2 u, Vec2 &offset, float *pmf_out) const {
     double frac;
-    uint32_t i = first_bin(u, frac);
-    const Bin &b = bins_[i];
-    double rest;
-    if (frac < b.threshold) {
-        rest = frac / b.threshold;
-        if (pmf_out) *pmf_out = b.pmf;
-    } else {
-        rest = (frac - b.threshold) / (1.0 - b.threshold);
-        i = b.alias;
-        if (pmf_out) *pmf_out = b.alias_pmf;
-    }
+    const uint32_t first = first_bin(u, frac);
+    const Bin &b = bins_[first];
+    // Keep the bin, or jump to its alias: chosen by selects, not a branch, since which way it goes is
+    // random (a branch is mispredicted about as often as the bins are split).
+    const bool keep = frac < double(b.threshold);
+    const double t = b.threshold, rest = (frac - select(keep, 0.0, t)) / select(keep, t, 1.0 - t);
+    if (pmf_out) *pmf_out = select(keep, b.pmf, b.alias_pmf);
     // Split the leftover variate into two: its coarse part and its fine part scaled back up.
     double fine = rest * 4096.0;
     offset = Vec2(float(std::min(rest, 0.99999994)), float(std::min(fine - std::floor(fine), 0.99999994)));
-    return i;
+    return select(keep, first, b.alias);
 }
 
 }  // namespace neepp

@@ -4,9 +4,10 @@
 // error is below 2e-9 (sin) and 2e-10 (cos), so the result is within about 1 ulp of the exact value
 // (tests/math/test_trig.cpp checks it against double precision).
 #pragma once
-#include <bit>
 #include <cmath>
 #include <cstdint>
+
+#include "neepp/math/select.h"
 
 namespace neepp {
 
@@ -42,12 +43,10 @@ inline SinCos sincos_turns(float t) {
     const float q = std::nearbyint(4.f * t);
     const SinCos r = sincos_quarter((t - 0.25f * q) * (2.f * 3.14159265358979323846f));
     const uint32_t quadrant = uint32_t(int32_t(q));
-    const uint32_t swap = 0u - (quadrant & 1u);  // odd quadrants: sin(x + pi/2) = cos x, cos(x + pi/2) = -sin x
-    const uint32_t s = std::bit_cast<uint32_t>(r.sin), c = std::bit_cast<uint32_t>(r.cos);
-    const uint32_t sin_bits = (s & ~swap) | (c & swap), cos_bits = (c & ~swap) | (s & swap);
+    const bool odd = quadrant & 1u;  // sin(x + pi/2) = cos x, cos(x + pi/2) = -sin x
     // The sine is negative in quadrants 2 and 3, the cosine in 1 and 2.
-    return {std::bit_cast<float>(sin_bits ^ ((quadrant & 2u) << 30)),
-            std::bit_cast<float>(cos_bits ^ (((quadrant + 1u) & 2u) << 30))};
+    return {flip_sign_if(quadrant & 2u, select(odd, r.cos, r.sin)),
+            flip_sign_if((quadrant + 1u) & 2u, select(odd, r.sin, r.cos))};
 }
 
 }  // namespace neepp
