@@ -478,6 +478,24 @@ TEST(EnvironmentMapLight, UvDirectionRoundTrip) {
     EXPECT_TRUE(seam.x < 1e-5f || seam.x > 1.f - 1e-5f) << seam.x;
 }
 
+TEST(EnvironmentMapLight, DirectionsAreUnitUnderAnyTransform) {
+    // A rotation keeps the map's unit directions unit (they are not normalized again); a to_world with a
+    // scale does not, and there they are. Lookups of a direction do not depend on its length.
+    const Transform scaled = Transform::scale(Vec3(3.f, 1.f, 0.5f)) * kEnvToWorld;
+    for (const Transform &t : {kEnvToWorld, scaled}) {
+        EnvironmentMapLight light(make_env_image(), t, 1.f);
+        PCG32 rng(10, 10);
+        for (int k = 0; k < 1000; ++k) {
+            const Vec2 uv(rng.next_float(), 0.01f + 0.98f * rng.next_float());
+            const Vec3 d = light.uv_to_direction(uv);
+            EXPECT_NEAR(norm(d), 1.f, 1e-6f);
+            const Vec2 a = light.direction_to_uv(d), b = light.direction_to_uv(d * 8.f);  // a power of two: scaled exactly
+            EXPECT_EQ(a.x, b.x);
+            EXPECT_EQ(a.y, b.y);
+        }
+    }
+}
+
 TEST(EnvironmentMapLight, TexelsSitOnMitsubasGrid) {
     // Texel (i, j) is seen at u = i / W (wrapping) and v = j / (H - 1) (first and last rows on the
     // poles); rows 0 and H-1 are skipped because u is undefined at the poles.
