@@ -8,6 +8,7 @@
 #include <cstdint>
 
 #include "neepp/math/select.h"
+#include "neepp/math/vec.h"
 
 namespace neepp {
 
@@ -41,7 +42,7 @@ constexpr SinCos sincos_quarter(float x) {
 // or two of it.
 inline SinCos sincos_turns(float t) {
     const float q = std::nearbyint(4.f * t);
-    const SinCos r = sincos_quarter((t - 0.25f * q) * (2.f * 3.14159265358979323846f));
+    const SinCos r = sincos_quarter((t - 0.25f * q) * (2.f * kPi));
     const uint32_t quadrant = uint32_t(int32_t(q));
     const bool odd = quadrant & 1u;  // sin(x + pi/2) = cos x, cos(x + pi/2) = -sin x
     // The sine is negative in quadrants 2 and 3, the cosine in 1 and 2.
