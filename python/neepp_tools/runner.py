@@ -122,8 +122,9 @@ def run_neepp(scene, out_exr, *, spp: int | None = None, time_s: float | None = 
               seed: int | None = 0, threads: int | None = None, integrator: str | None = None,
               integrator_args: dict | None = None, defines: dict | None = None,
               binary=None, timeout: float | None = None, quiet: bool = True,
-              extra_args: list | None = None) -> RenderResult:
-    """Render scene with ``neepp render`` and read back OUT.exr and the stats JSON."""
+              extra_args: list | None = None, env: dict | None = None) -> RenderResult:
+    """Render scene with ``neepp render`` and read back OUT.exr and the stats JSON. env: variables set
+    for the child on top of this process's environment."""
     binary = Path(binary) if binary else find_neepp()
     if binary is None:
         raise RenderError("neepp binary not found (set NEEPP_BIN or build <repo>/build/neepp)")
@@ -160,7 +161,7 @@ def run_neepp(scene, out_exr, *, spp: int | None = None, time_s: float | None = 
     if quiet:
         cmd.append("--quiet")
     cmd += [str(x) for x in (extra_args or [])]
-    rc, out, wall, rss = _run_child(cmd, timeout=timeout)
+    rc, out, wall, rss = _run_child(cmd, env=dict(os.environ, **env) if env else None, timeout=timeout)
     if rc != 0 or not out_exr.exists():
         raise RenderError(f"neepp failed (rc={rc}): {' '.join(cmd)}\n{out[-4000:]}")
     stats = json.loads(stats_path.read_text()) if stats_path.exists() else {}
