@@ -9,8 +9,10 @@ enum class Query : uint8_t { Intersect = 0, Occluded = 1 };
 
 struct CallHeader {
     Query query;
-    uint8_t width;  // 1, 4, 8 or 16: the Embree entry point called (rtcIntersect8, ...)
-    uint16_t rays;  // the call's active rays, in lane order; as many RayRecords follow
+    uint8_t width;     // 1, 4, 8 or 16: the Embree entry point called (rtcIntersect8, ...)
+    uint8_t coherent;  // 1 when the call's context had RTC_INTERSECT_CONTEXT_FLAG_COHERENT
+    uint8_t reserved = 0;
+    uint32_t rays;     // the call's active rays, in lane order; as many RayRecords follow
 };
 
 struct RayRecord {

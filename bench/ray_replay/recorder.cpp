@@ -6,10 +6,14 @@
 #include <embree3/rtcore.h>
 
 #include <dlfcn.h>
+#include <fcntl.h>
+#include <unistd.h>
 
 #include <atomic>
+#include <cerrno>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <string>
 #include <vector>
 
@@ -22,24 +26,37 @@ using neepp::ray_replay::RayRecord;
 
 std::atomic<int> next_file{0};
 
-// One buffered file per thread, flushed when the thread or the process ends.
+// One file per thread. Each call is written whole with one write(2), unbuffered: the render's worker
+// threads may still be alive when the process exits, so a stdio buffer's tail could be lost (it was, on
+// about one run in ten), while a write that has returned is in the file.
 struct ThreadFile {
-    FILE *file = nullptr;
+    int fd = -1;
+    std::vector<char> buffer;
     ThreadFile() {
         const char *dir = std::getenv("NEEPP_RAY_RECORD_DIR");
         const std::string path = std::string(dir ? dir : ".") + "/rays." + std::to_string(next_file++) + ".bin";
-        file = std::fopen(path.c_str(), "wb");
-        if (!file) {
+        fd = ::open(path.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+        if (fd < 0) {
             std::fprintf(stderr, "ray recorder: cannot write %s\n", path.c_str());
             std::abort();
         }
-        std::setvbuf(file, nullptr, _IOFBF, 1 << 20);
     }
-    ~ThreadFile() { std::fclose(file); }
-    void write(Query query, int width, const std::vector<RayRecord> &rays) {
-        const CallHeader h{query, uint8_t(width), uint16_t(rays.size())};
-        std::fwrite(&h, sizeof h, 1, file);
-        std::fwrite(rays.data(), sizeof(RayRecord), rays.size(), file);
+    ~ThreadFile() { ::close(fd); }
+    void write(Query query, int width, const RTCIntersectContext *ctx, const std::vector<RayRecord> &rays) {
+        const CallHeader h{query, uint8_t(width), uint8_t((ctx->flags & RTC_INTERSECT_CONTEXT_FLAG_COHERENT) != 0), 0,
+                           uint32_t(rays.size())};
+        buffer.resize(sizeof h + rays.size() * sizeof(RayRecord));
+        std::memcpy(buffer.data(), &h, sizeof h);
+        std::memcpy(buffer.data() + sizeof h, rays.data(), rays.size() * sizeof(RayRecord));
+        for (size_t done = 0; done < buffer.size();) {
+            const ssize_t n = ::write(fd, buffer.data() + done, buffer.size() - done);
+            if (n < 0 && errno == EINTR) continue;
+            if (n <= 0) {
+                std::fprintf(stderr, "ray recorder: write failed: %s\n", std::strerror(errno));
+                std::abort();
+            }
+            done += size_t(n);
+        }
     }
 };
 thread_local ThreadFile out;
@@ -73,7 +90,7 @@ void intersect_packet(const char *name, const int *valid, RTCScene scene, RTCInt
     call(valid, scene, ctx, rh);
     for (int i = 0, k = 0; i < W; ++i)
         if (valid[i]) rays[k++].hit = rh->hit.geomID[i] != RTC_INVALID_GEOMETRY_ID;
-    out.write(Query::Intersect, W, rays);
+    out.write(Query::Intersect, W, ctx, rays);
 }
 
 template <int W, typename Rays>
@@ -86,7 +103,7 @@ void occluded_packet(const char *name, const int *valid, RTCScene scene, RTCInte
     call(valid, scene, ctx, r);
     for (int i = 0, k = 0; i < W; ++i)
         if (valid[i]) rays[k++].hit = r->tfar[i] < 0;
-    out.write(Query::Occluded, W, rays);
+    out.write(Query::Occluded, W, ctx, rays);
 }
 }  // namespace
 
@@ -96,14 +113,14 @@ void rtcIntersect1(RTCScene scene, RTCIntersectContext *ctx, RTCRayHit *rh) {
     std::vector<RayRecord> rays{single(rh->ray)};
     call(scene, ctx, rh);
     rays[0].hit = rh->hit.geomID != RTC_INVALID_GEOMETRY_ID;
-    out.write(Query::Intersect, 1, rays);
+    out.write(Query::Intersect, 1, ctx, rays);
 }
 void rtcOccluded1(RTCScene scene, RTCIntersectContext *ctx, RTCRay *r) {
     static const auto call = real<void (*)(RTCScene, RTCIntersectContext *, RTCRay *)>("rtcOccluded1");
     std::vector<RayRecord> rays{single(*r)};
     call(scene, ctx, r);
     rays[0].hit = r->tfar < 0;
-    out.write(Query::Occluded, 1, rays);
+    out.write(Query::Occluded, 1, ctx, rays);
 }
 void rtcIntersect4(const int *v, RTCScene s, RTCIntersectContext *c, RTCRayHit4 *rh) { intersect_packet<4>("rtcIntersect4", v, s, c, rh); }
 void rtcIntersect8(const int *v, RTCScene s, RTCIntersectContext *c, RTCRayHit8 *rh) { intersect_packet<8>("rtcIntersect8", v, s, c, rh); }

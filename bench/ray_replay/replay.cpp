@@ -6,7 +6,8 @@
 // The scene is loaded and built exactly as neepp render does (same loader, same Embree build settings).
 // Each file is one render thread's calls, replayed in order on a thread of its own, all at once; each
 // rep times every way of tracing: as the render's own packets (Scene::trace16/occluded16, the same
-// grouping of rays), and one ray at a time (rtcIntersect1/rtcOccluded1). Every replayed outcome is
+// grouping of rays, with the coherent flag where the render gave it), and one ray at a time
+// (rtcIntersect1/rtcOccluded1). Every replayed outcome is
 // checked against the one recorded in the render. Prints JSON.
 #include <algorithm>
 #include <chrono>
@@ -28,6 +29,7 @@ using namespace neepp::ray_replay;
 
 struct Call {
     Query query;
+    bool coherent;     // traced with Embree's coherent flag in the render (camera rays), and so again
     int first, count;  // its rays in Stream::rays
 };
 
@@ -43,9 +45,9 @@ Stream read_stream(const std::string &path) {
     Stream s;
     CallHeader h;
     while (in.read(reinterpret_cast<char *>(&h), sizeof h)) {
-        if (h.query != Query::Intersect && h.query != Query::Occluded)
+        if ((h.query != Query::Intersect && h.query != Query::Occluded) || h.coherent > 1 || h.rays > 16)
             throw std::runtime_error(path + ": not a ray record file (bad call header)");
-        s.calls.push_back({h.query, int(s.rays.size()), int(h.rays)});
+        s.calls.push_back({h.query, h.coherent != 0, int(s.rays.size()), int(h.rays)});
         for (int i = 0; i < h.rays; ++i) {
             RayRecord r;
             if (!in.read(reinterpret_cast<char *>(&r), sizeof r)) throw std::runtime_error(path + ": truncated");
@@ -72,10 +74,10 @@ size_t replay(const Scene &scene, const Stream &s, Mode mode, std::vector<uint8_
             uint8_t *o = &outcome[c.first + b];
             if (mode == Mode::Packets) {
                 if (c.query == Query::Intersect) {
-                    scene.trace16(rs, hs, m);
+                    scene.trace16(rs, hs, m, c.coherent);
                     for (int i = 0; i < m; ++i) o[i] = hits[i].valid();
                 } else {
-                    scene.occluded16(rs, m, occluded);
+                    scene.occluded16(rs, m, occluded, c.coherent);
                     for (int i = 0; i < m; ++i) o[i] = occluded[i];
                 }
             } else {

@@ -16,7 +16,7 @@ spec = importlib.util.spec_from_file_location("embree_floor", REPO / "bench" / "
 embree_floor = importlib.util.module_from_spec(spec)
 spec.loader.exec_module(embree_floor)
 
-HEADER_BYTES, RECORD_BYTES, HIT_OFFSET = 4, 36, 32  # bench/ray_replay/ray_record.h
+HEADER_BYTES, RECORD_BYTES, HIT_OFFSET = 8, 36, 32  # bench/ray_replay/ray_record.h
 
 
 @pytest.fixture(scope="module")

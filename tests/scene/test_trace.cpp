@@ -43,10 +43,12 @@ TEST(SceneTrace, PacketsFindTheSameHitsAsSingleRays) {
                 rp[i] = &rays[i], hp[i] = &packet[i];
             }
             scene->trace16(rp.data(), hp.data(), n);
-            bool occluded[16];
-            scene->occluded16(rp.data(), n, occluded);
-            for (int i = 0; i < n; ++i) ASSERT_EQ(occluded[i], scene->occluded(rays[i]))
-                    << "ray " << i << " of " << n << ", width " << width;
+            for (bool coherent : {false, true}) {
+                bool occluded[16];
+                scene->occluded16(rp.data(), n, occluded, coherent);
+                for (int i = 0; i < n; ++i) ASSERT_EQ(occluded[i], scene->occluded(rays[i]))
+                        << "ray " << i << " of " << n << ", width " << width << (coherent ? ", coherent" : "");
+            }
             for (int i = 0; i < n; ++i) {
                 const RayHit single = scene->trace(rays[i]);
                 ASSERT_EQ(single.valid(), packet[i].valid()) << "ray " << i << " of " << n << ", width " << width;

@@ -103,9 +103,10 @@ void intersect_packets(RTCScene scene, const Ray *const *rays, RayHit *const *hi
 }
 
 template <int W>
-void occluded_packets(RTCScene scene, const Ray *const *rays, int n, bool *occluded) {
+void occluded_packets(RTCScene scene, const Ray *const *rays, int n, bool *occluded, bool coherent) {
     RTCIntersectContext ctx;
     rtcInitIntersectContext(&ctx);
+    if (coherent) ctx.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
     for (int b = 0; b < n; b += W) {
         const int m = std::min(W, n - b);
         alignas(64) int valid[W];
@@ -242,8 +243,8 @@ bool Scene::intersect(const Ray &ray, SurfaceInteraction &si) const {
     return true;
 }
 
-void Scene::occluded16(const Ray *const *rays, int n, bool *occluded) const {
-    with_packet_width(packet_width_, [&](auto w) { occluded_packets<w()>(rtc_scene_, rays, n, occluded); });
+void Scene::occluded16(const Ray *const *rays, int n, bool *occluded, bool coherent) const {
+    with_packet_width(packet_width_, [&](auto w) { occluded_packets<w()>(rtc_scene_, rays, n, occluded, coherent); });
 }
 
 bool Scene::occluded(const Ray &ray) const {
