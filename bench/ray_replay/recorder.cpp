@@ -80,31 +80,26 @@ RayRecord single(const RTCRay &r) {
     return {{r.org_x, r.org_y, r.org_z}, {r.dir_x, r.dir_y, r.dir_z}, r.tnear, r.tfar, 0};
 }
 
-template <int W, typename Hits>
-void intersect_packet(const char *name, const int *valid, RTCScene scene, RTCIntersectContext *ctx, Hits *rh) {
-    static const auto call = real<void (*)(const int *, RTCScene, RTCIntersectContext *, Hits *)>(name);
+// An Embree packet call (rtcIntersectW or rtcOccludedW, on arg: RTCRayHitW or RTCRayW), recorded: the
+// valid lanes' rays before the call, their outcomes (outcome(arg, lane)) after it.
+template <int W, typename Arg, typename Outcome>
+void packet(Query query, const char *name, const int *valid, RTCScene scene, RTCIntersectContext *ctx, Arg *arg,
+            Outcome outcome) {
+    static const auto call = real<void (*)(const int *, RTCScene, RTCIntersectContext *, Arg *)>(name);
     thread_local std::vector<RayRecord> rays;
     rays.clear();
     for (int i = 0; i < W; ++i)
-        if (valid[i]) rays.push_back(lane(rh->ray, i));
-    call(valid, scene, ctx, rh);
+        if (valid[i]) {
+            if constexpr (requires { arg->hit; }) rays.push_back(lane(arg->ray, i));
+            else rays.push_back(lane(*arg, i));
+        }
+    call(valid, scene, ctx, arg);
     for (int i = 0, k = 0; i < W; ++i)
-        if (valid[i]) rays[k++].hit = rh->hit.geomID[i] != RTC_INVALID_GEOMETRY_ID;
-    out.write(Query::Intersect, W, ctx, rays);
+        if (valid[i]) rays[k++].hit = outcome(*arg, i);
+    out.write(query, W, ctx, rays);
 }
-
-template <int W, typename Rays>
-void occluded_packet(const char *name, const int *valid, RTCScene scene, RTCIntersectContext *ctx, Rays *r) {
-    static const auto call = real<void (*)(const int *, RTCScene, RTCIntersectContext *, Rays *)>(name);
-    thread_local std::vector<RayRecord> rays;
-    rays.clear();
-    for (int i = 0; i < W; ++i)
-        if (valid[i]) rays.push_back(lane(*r, i));
-    call(valid, scene, ctx, r);
-    for (int i = 0, k = 0; i < W; ++i)
-        if (valid[i]) rays[k++].hit = r->tfar[i] < 0;
-    out.write(Query::Occluded, W, ctx, rays);
-}
+const auto hit_something = [](const auto &rh, int i) { return rh.hit.geomID[i] != RTC_INVALID_GEOMETRY_ID; };
+const auto blocked = [](const auto &r, int i) { return r.tfar[i] < 0; };  // Embree sets tfar to -inf on a hit
 }  // namespace
 
 extern "C" {
@@ -119,13 +114,18 @@ void rtcOccluded1(RTCScene scene, RTCIntersectContext *ctx, RTCRay *r) {
     static const auto call = real<void (*)(RTCScene, RTCIntersectContext *, RTCRay *)>("rtcOccluded1");
     std::vector<RayRecord> rays{single(*r)};
     call(scene, ctx, r);
-    rays[0].hit = r->tfar < 0;
+    rays[0].hit = r->tfar < 0;  // as blocked
     out.write(Query::Occluded, 1, ctx, rays);
 }
-void rtcIntersect4(const int *v, RTCScene s, RTCIntersectContext *c, RTCRayHit4 *rh) { intersect_packet<4>("rtcIntersect4", v, s, c, rh); }
-void rtcIntersect8(const int *v, RTCScene s, RTCIntersectContext *c, RTCRayHit8 *rh) { intersect_packet<8>("rtcIntersect8", v, s, c, rh); }
-void rtcIntersect16(const int *v, RTCScene s, RTCIntersectContext *c, RTCRayHit16 *rh) { intersect_packet<16>("rtcIntersect16", v, s, c, rh); }
-void rtcOccluded4(const int *v, RTCScene s, RTCIntersectContext *c, RTCRay4 *r) { occluded_packet<4>("rtcOccluded4", v, s, c, r); }
-void rtcOccluded8(const int *v, RTCScene s, RTCIntersectContext *c, RTCRay8 *r) { occluded_packet<8>("rtcOccluded8", v, s, c, r); }
-void rtcOccluded16(const int *v, RTCScene s, RTCIntersectContext *c, RTCRay16 *r) { occluded_packet<16>("rtcOccluded16", v, s, c, r); }
+// The packet entry points, one pair per width: exported C symbols, so spelled out by a macro.
+#define NEEPP_RECORD_PACKETS(W)                                                                 \
+    void rtcIntersect##W(const int *v, RTCScene s, RTCIntersectContext *c, RTCRayHit##W *rh) {   \
+        packet<W>(Query::Intersect, "rtcIntersect" #W, v, s, c, rh, hit_something);             \
+    }                                                                                           \
+    void rtcOccluded##W(const int *v, RTCScene s, RTCIntersectContext *c, RTCRay##W *r) {       \
+        packet<W>(Query::Occluded, "rtcOccluded" #W, v, s, c, r, blocked);                      \
+    }
+NEEPP_RECORD_PACKETS(4)
+NEEPP_RECORD_PACKETS(8)
+NEEPP_RECORD_PACKETS(16)
 }
