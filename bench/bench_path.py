@@ -28,13 +28,24 @@ import json
 import os
 import statistics
 import sys
+import tempfile
 import time
 from pathlib import Path
 
 REPO = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(REPO / "python"))
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+
+import embree_floor  # noqa: E402
 
 from neepp_tools import REFERENCES, SCENES_DIR, credit, exr, machine, metrics, report, runner  # noqa: E402
+
+
+FLOOR_NOTE = """
+Embree floor: samples/s if a sample cost only its ray queries (bench/embree_floor.py: a 2 spp render's rays
+recorded and traced again by Embree alone); neepp ray share: neepp's samples/s over the floor, the part of
+its time that is ray queries; floor/Mitsuba: the largest ratio reachable without fewer or cheaper rays.
+"""
 
 
 def med(xs):
@@ -61,6 +72,8 @@ def main(argv=None) -> int:
     ap.add_argument("--skip-neepp", action="store_true")
     ap.add_argument("--skip-mitsuba", action="store_true")
     ap.add_argument("--timeout", type=float, default=1800.0, help="per render, seconds")
+    ap.add_argument("--no-floor", action="store_true",
+                    help="skip the Embree floor (bench/embree_floor.py: a 2 spp render's rays replayed alone)")
     a = ap.parse_args(argv)
     if a.quick:
         a.spp, a.reps = 16, 1
@@ -141,7 +154,14 @@ def main(argv=None) -> int:
                 pairs = list(itertools.combinations(images[k], 2))
                 summ[k]["relvar"] = (statistics.fmean(metrics.relative_variance(x, y, ref) for x, y in pairs)
                                      if pairs else None)
-        results["scenes"][scene] = {"width": w, "height": h, "runs": runs, "median": summ}
+        floor = None
+        if neepp is not None and not a.no_floor and all(p.exists() for p in embree_floor.tools_beside(neepp)):
+            with tempfile.TemporaryDirectory(prefix="neepp_floor_") as tmp:
+                floor = embree_floor.ray_floor(xml, {"resx": w, "resy": h, "max_depth": a.max_depth}, w * h * 2,
+                                               neepp, record_spp=2, reps=3, threads=a.threads, workdir=Path(tmp))
+            print(f"[{scene}] Embree floor: {floor['floor_samples_per_s']:,.0f} samples/s "
+                  f"({floor['rays_per_sample']:.2f} rays per sample)", file=sys.stderr, flush=True)
+        results["scenes"][scene] = {"width": w, "height": h, "runs": runs, "median": summ, "floor": floor}
         n, m = summ.get("neepp", {}), summ.get("mitsuba", {})
         # ratio per repetition (the two renders of a rep ran back to back), then the median
         rep_ratios = [x["samples_per_s"] / y["samples_per_s"] for x, y in zip(runs["neepp"], runs["mitsuba"])
@@ -156,7 +176,12 @@ def main(argv=None) -> int:
                      "neepp_relvar": n.get("relvar"), "mi_relvar": m.get("relvar"),
                      "neepp_mean": n.get("mean_ratio"), "mi_mean": m.get("mean_ratio"),
                      "neepp_mem": n.get("peak_memory_mb"), "mi_mem": m.get("peak_memory_mb"),
-                     "neepp_load": n.get("load_time_s"), "mi_load": m.get("load_time_s")})
+                     "neepp_load": n.get("load_time_s"), "mi_load": m.get("load_time_s"),
+                     "floor_sps": msps(floor and floor["floor_samples_per_s"]),
+                     "ray_share": (n["samples_per_s"] / floor["floor_samples_per_s"]
+                                   if floor and n.get("samples_per_s") else None),
+                     "floor_ratio": (floor["floor_samples_per_s"] / m["samples_per_s"]
+                                     if floor and m.get("samples_per_s") else None)})
         last_img = {k: imgs[-1] for k, imgs in images.items() if imgs}
         if last_img:
             report.comparison_figure(out / f"{scene}_compare.png", last_img, ref,
@@ -171,7 +196,8 @@ def main(argv=None) -> int:
                "neepp_relvar": "neepp relVar", "mi_relvar": "Mitsuba relVar",
                "neepp_mean": "neepp mean/ref", "mi_mean": "Mitsuba mean/ref",
                "neepp_mem": "neepp peak MB", "mi_mem": "Mitsuba peak MB",
-               "neepp_load": "neepp load s", "mi_load": "Mitsuba load s"}
+               "neepp_load": "neepp load s", "mi_load": "Mitsuba load s",
+               "floor_sps": "Embree floor M samples/s", "ray_share": "neepp ray share", "floor_ratio": "floor/Mitsuba"}
     table = report.markdown_table(rows, list(headers), headers)
     credits = "".join(f"\n- {scene}: {credit(scene)}" for scene in scenes if credit(scene))
     if credits:
@@ -179,7 +205,7 @@ def main(argv=None) -> int:
     md = (f"path, max_depth {a.max_depth}, {a.spp} spp, median of {a.reps} rep(s), "
           f"{results['threads']} threads, load avg {results['loadavg_start'][0]:.2f} -> {results['loadavg_end'][0]:.2f}; "
           f"relMSE against shared/scenes/<scene>/reference (Mitsuba 3.9.1 llvm_ad_rgb, 2272-6032 spp)\n"
-          f"machine: {machine.summary(results['machine'])}\n\n{table}\n{credits}")
+          f"machine: {machine.summary(results['machine'])}\n\n{table}\n{FLOOR_NOTE}{credits}")
     (out / "report.md").write_text(md)
     (out / "results.json").write_text(json.dumps(results, indent=2, default=float))
     print(md)

@@ -58,11 +58,43 @@ def replay(replay_bin: Path, scene: Path, defines: dict, files: list[Path], reps
     return json.loads(r.stdout)
 
 
-def measure(scene_name: str, scene: Path, res: tuple[int, int], a, binary: Path) -> dict:
+def ray_floor(scene: Path, defines: dict, samples: int, binary: Path, *, record_spp: int, reps: int,
+              threads: int = 0, workdir: Path) -> dict:
+    """Records a render of `samples` camera samples (record_spp per pixel) and replays its rays: rays per
+    sample, Embree's rays/s alone (packets, single) and the floor in samples/s. Checks the recording is
+    complete and every replayed outcome matches the render's."""
     recorder, replay_bin = tools_beside(binary)
+    rec_dir = workdir / "rays"
+    rec_dir.mkdir(parents=True, exist_ok=True)
+    rec = runner.run_neepp(scene, workdir / "recorded.exr", spp=record_spp, threads=threads, defines=defines,
+                           binary=binary, env={"LD_PRELOAD": str(recorder), "NEEPP_RAY_RECORD_DIR": str(rec_dir)})
+    files = sorted(rec_dir.glob("rays.*.bin"))
+    if not files:
+        raise SystemExit(f"the recorder wrote nothing under {rec_dir}: was {recorder} preloaded?")
+    rp = replay(replay_bin, scene, defines, files, reps)
+    st = rec.stats
+    if rp["intersect_rays"] != st["rays"] or rp["occluded_rays"] != st["shadow_rays"]:
+        raise SystemExit(f"{scene}: recorded {rp['intersect_rays']} + {rp['occluded_rays']} rays, the render "
+                         f"counted {st['rays']} + {st['shadow_rays']}: the recording is incomplete")
+    for mode in ("packets", "single"):
+        if rp[mode]["mismatches"]:
+            raise SystemExit(f"{scene}: replay ({mode}) disagrees with the render on {rp[mode]['mismatches']} rays")
+    rays = rp["intersect_rays"] + rp["occluded_rays"]
+    out = {"record_spp": record_spp, "intersect_per_sample": rp["intersect_rays"] / samples,
+           "shadow_per_sample": rp["occluded_rays"] / samples, "rays_per_sample": rays / samples,
+           "replay_threads": rp["threads"], "packet_width": rp["packet_width"]}
+    for mode in ("packets", "single"):
+        secs = statistics.median(rp[mode]["seconds"])
+        out[mode] = {"seconds": rp[mode]["seconds"], "rays_per_s": rays / secs,
+                     "ns_per_ray_per_thread": secs * rp["threads"] / rays * 1e9}
+    out["floor_samples_per_s"] = out["packets"]["rays_per_s"] / out["rays_per_sample"]
+    return out
+
+
+def measure(scene_name: str, scene: Path, res: tuple[int, int], a, binary: Path) -> dict:
     w, h = res
     defines = {"resx": w, "resy": h, "max_depth": a.max_depth}
-    timed = []
+    timed, mitsuba = [], []
     with tempfile.TemporaryDirectory(prefix="neepp_floor_") as tmp:
         tmp = Path(tmp)
         for rep in range(a.reps):
@@ -70,42 +102,15 @@ def measure(scene_name: str, scene: Path, res: tuple[int, int], a, binary: Path)
                                  defines=defines, binary=binary)
             timed.append(r.stats["samples_per_s"])
             print(f"[{scene_name}] render rep {rep}: {timed[-1]:,.0f} samples/s", flush=True)
-        rec_dir = tmp / "rays"
-        rec_dir.mkdir()
-        rec = runner.run_neepp(scene, tmp / "recorded.exr", spp=a.record_spp, threads=a.threads,
-                               defines=defines, binary=binary,
-                               env={"LD_PRELOAD": str(recorder), "NEEPP_RAY_RECORD_DIR": str(rec_dir)})
-        files = sorted(rec_dir.glob("rays.*.bin"))
-        if not files:
-            raise SystemExit(f"the recorder wrote nothing under {rec_dir}: was {recorder} preloaded?")
-        rp = replay(replay_bin, scene, defines, files, a.reps)
-        mitsuba = []
+        floor = ray_floor(scene, defines, w * h * a.record_spp, binary, record_spp=a.record_spp, reps=a.reps,
+                          threads=a.threads, workdir=tmp)
         for rep in range(a.reps if a.mitsuba else 0):
             r = runner.run_mitsuba(scene, tmp / "mitsuba.exr", resx=w, resy=h, spp=a.spp, max_depth=a.max_depth,
                                    seed=rep, threads=a.threads)
             mitsuba.append(r.stats["samples_per_s"])
             print(f"[{scene_name}] mitsuba rep {rep}: {mitsuba[-1]:,.0f} samples/s", flush=True)
-    st = rec.stats
-    samples = w * h * a.record_spp
-    if rp["intersect_rays"] != st["rays"] or rp["occluded_rays"] != st["shadow_rays"]:
-        raise SystemExit(f"[{scene_name}] recorded {rp['intersect_rays']} + {rp['occluded_rays']} rays, the render "
-                         f"counted {st['rays']} + {st['shadow_rays']}: the recording is incomplete")
-    for mode in ("packets", "single"):
-        if rp[mode]["mismatches"]:
-            raise SystemExit(f"[{scene_name}] replay ({mode}) disagrees with the render on "
-                             f"{rp[mode]['mismatches']} rays")
-    rays = rp["intersect_rays"] + rp["occluded_rays"]
-    per_sample = rays / samples
-    out = {"scene": scene_name, "resolution": [w, h], "spp": a.spp, "record_spp": a.record_spp,
-           "render_samples_per_s": statistics.median(timed), "render_runs": timed,
-           "intersect_per_sample": rp["intersect_rays"] / samples,
-           "shadow_per_sample": rp["occluded_rays"] / samples, "rays_per_sample": per_sample,
-           "replay_threads": rp["threads"], "packet_width": rp["packet_width"]}
-    for mode in ("packets", "single"):
-        secs = statistics.median(rp[mode]["seconds"])
-        out[mode] = {"seconds": rp[mode]["seconds"], "rays_per_s": rays / secs,
-                     "ns_per_ray_per_thread": secs * rp["threads"] / rays * 1e9}
-    out["floor_samples_per_s"] = out["packets"]["rays_per_s"] / per_sample
+    out = {"scene": scene_name, "resolution": [w, h], "spp": a.spp, "render_samples_per_s": statistics.median(timed),
+           "render_runs": timed, **floor}
     out["ray_share"] = out["render_samples_per_s"] / out["floor_samples_per_s"]
     if mitsuba:
         out["mitsuba_samples_per_s"] = statistics.median(mitsuba)
