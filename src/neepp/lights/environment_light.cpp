@@ -210,8 +210,9 @@ LightSampleStart EnvironmentMapLight::begin_sample(Vec2 u) const {
     const int y = std::min(int(start.point.y * float(height_ - 1)), height_ - 1), y1 = std::min(y + 1, height_ - 1);
     for (int row : {y, y1}) {
         const size_t i = 3 * (size_t(row) * width_ + x);
-        if (!half_.empty()) __builtin_prefetch(&half_[i]), __builtin_prefetch(&half_[i + 6]);
-        else __builtin_prefetch(&float_[i]), __builtin_prefetch(&float_[i + 5]);
+        // (the last byte's index is clamped: past a row's end the footprint wraps, past the map's it stops)
+        if (!half_.empty()) __builtin_prefetch(&half_[i]), __builtin_prefetch(&half_[std::min(i + 6, half_.size() - 1)]);
+        else __builtin_prefetch(&float_[i]), __builtin_prefetch(&float_[std::min(i + 5, float_.size() - 1)]);
     }
     return start;
 }
