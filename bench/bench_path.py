@@ -157,8 +157,8 @@ def main(argv=None) -> int:
         floor = None
         if neepp is not None and not a.no_floor and all(p.exists() for p in embree_floor.tools_beside(neepp)):
             with tempfile.TemporaryDirectory(prefix="neepp_floor_") as tmp:
-                floor = embree_floor.ray_floor(xml, {"resx": w, "resy": h, "max_depth": a.max_depth}, w * h * 2,
-                                               neepp, record_spp=2, reps=3, threads=a.threads, workdir=Path(tmp))
+                floor = embree_floor.ray_floor(xml, {"resx": w, "resy": h, "max_depth": a.max_depth}, neepp,
+                                               record_spp=2, reps=3, threads=a.threads, workdir=Path(tmp))
             print(f"[{scene}] Embree floor: {floor['floor_samples_per_s']:,.0f} samples/s "
                   f"({floor['rays_per_sample']:.2f} rays per sample)", file=sys.stderr, flush=True)
         results["scenes"][scene] = {"width": w, "height": h, "runs": runs, "median": summ, "floor": floor}

@@ -58,11 +58,12 @@ def replay(replay_bin: Path, scene: Path, defines: dict, files: list[Path], reps
     return json.loads(r.stdout)
 
 
-def ray_floor(scene: Path, defines: dict, samples: int, binary: Path, *, record_spp: int, reps: int,
-              threads: int = 0, workdir: Path) -> dict:
-    """Records a render of `samples` camera samples (record_spp per pixel) and replays its rays: rays per
-    sample, Embree's rays/s alone (packets, single) and the floor in samples/s. Checks the recording is
-    complete and every replayed outcome matches the render's."""
+def ray_floor(scene: Path, defines: dict, binary: Path, *, record_spp: int, reps: int, threads: int = 0,
+              workdir: Path) -> dict:
+    """Records a render at record_spp (defines give resx and resy) and replays its rays: rays per sample,
+    Embree's rays/s alone (packets, single) and the floor in samples/s. Checks the recording is complete
+    and every replayed outcome matches the render's."""
+    samples = int(defines["resx"]) * int(defines["resy"]) * record_spp
     recorder, replay_bin = tools_beside(binary)
     rec_dir = workdir / "rays"
     rec_dir.mkdir(parents=True, exist_ok=True)
@@ -102,8 +103,8 @@ def measure(scene_name: str, scene: Path, res: tuple[int, int], a, binary: Path)
                                  defines=defines, binary=binary)
             timed.append(r.stats["samples_per_s"])
             print(f"[{scene_name}] render rep {rep}: {timed[-1]:,.0f} samples/s", flush=True)
-        floor = ray_floor(scene, defines, w * h * a.record_spp, binary, record_spp=a.record_spp, reps=a.reps,
-                          threads=a.threads, workdir=tmp)
+        floor = ray_floor(scene, defines, binary, record_spp=a.record_spp, reps=a.reps, threads=a.threads,
+                          workdir=tmp)
         for rep in range(a.reps if a.mitsuba else 0):
             r = runner.run_mitsuba(scene, tmp / "mitsuba.exr", resx=w, resy=h, spp=a.spp, max_depth=a.max_depth,
                                    seed=rep, threads=a.threads)

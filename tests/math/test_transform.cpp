@@ -1,5 +1,5 @@
 // Transform: inverses, rotation handedness, Mitsuba's lookat, normals under non-uniform scale, and
-// orientation flips.
+// orientation flips, lengths kept, inverse directions.
 #include <gtest/gtest.h>
 
 #include "neepp/math/transform.h"
@@ -98,6 +98,22 @@ TEST(Transform, FlipsHandedness) {
     EXPECT_TRUE((composite() * Transform::scale(Vec3(1, 1, -2))).flips_handedness());
     // A translation in the last column does not enter the determinant of the linear part.
     EXPECT_FALSE(Transform::translate(Vec3(-5, -5, -5)).flips_handedness());
+}
+
+TEST(Transform, PreservesLengths) {
+    EXPECT_TRUE(Transform().preserves_lengths());
+    EXPECT_TRUE(Transform::rotate(Vec3(1, 2, -0.5f), 33.f).preserves_lengths());
+    EXPECT_TRUE(Transform::look_at(Vec3(1, 2, 3), Vec3(0, 0, 0), Vec3(0, 1, 0)).preserves_lengths());
+    EXPECT_TRUE((Transform::translate(Vec3(4, 5, 6)) * Transform::scale(Vec3(-1, 1, 1))).preserves_lengths());
+    EXPECT_FALSE(composite().preserves_lengths());
+    EXPECT_FALSE(Transform::scale(Vec3(1, 1, 1.01f)).preserves_lengths());
+}
+
+TEST(Transform, InverseVectorUndoesVector) {
+    const Transform t = composite();
+    const Vec3 v(0.3f, -1.2f, 2.f);
+    expect_vec_near(t.inverse_vector(t.vector(v)), v);
+    expect_vec_near(t.inverse_vector(v), t.inverse().vector(v));
 }
 
 }  // namespace

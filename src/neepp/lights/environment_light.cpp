@@ -14,16 +14,7 @@
 namespace neepp {
 
 EnvironmentMapLight::EnvironmentMapLight(Image image, const Transform &to_world, float scale)
-    : to_world_(to_world), to_local_(to_world.inverse()), scale_(scale) {
-    // Whether to_world's linear part is a rotation (orthonormal columns): then it keeps unit vectors
-    // unit, and directions need no normalizing (an envmap's to_world is one, or the identity, in practice).
-    rotation_ = true;
-    for (int i = 0; i < 3; ++i)
-        for (int j = 0; j < 3; ++j) {
-            float d = 0;
-            for (int k = 0; k < 3; ++k) d += to_world.matrix.m[k][i] * to_world.matrix.m[k][j];
-            rotation_ = rotation_ && std::abs(d - (i == j ? 1.f : 0.f)) < 1e-6f;
-        }
+    : to_world_(to_world), rotation_(to_world.preserves_lengths()), scale_(scale) {
     width_ = image.width, height_ = image.height;
     if (image.width < 2 || image.height < 2) throw std::runtime_error("envmap: image too small");
     const int w = width_, h = height_;
@@ -129,7 +120,7 @@ EnvironmentMapLight::EnvironmentMapLight(Image image, const Transform &to_world,
 }
 
 Vec2 EnvironmentMapLight::direction_to_uv(const Vec3 &d_world) const {
-    const Vec3 v = to_local_.vector(d_world);  // not normalized: both angles below ignore its length
+    const Vec3 v = to_world_.inverse_vector(d_world);  // not normalized: both angles below ignore its length
     float u = std::atan2(v.x, -v.z) * kInv2Pi;
     if (u < 0) u += 1.f;
     // atan2 keeps precision near the poles, where acos(y) loses it.

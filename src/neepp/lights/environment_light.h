@@ -54,8 +54,10 @@ private:
     int width_ = 0, height_ = 0;
     std::vector<uint16_t> half_;
     std::vector<float> float_;
-    Transform to_world_, to_local_;  // to_local_: its inverse, kept rather than built per lookup
-    bool rotation_ = false;          // to_world_ keeps lengths: directions need no normalizing
+    Transform to_world_;
+    // to_world_ keeps lengths (an envmap's to_world is a rotation, or the identity, in practice): the
+    // directions it turns need no normalizing.
+    bool rotation_ = false;
     float scale_;
     static constexpr int kMaxSampleWidth = 1024;
     AliasTable cells_;  // sampling cells (texel cells merged down to at most 1024x512), ∝ luminance × sin(theta)

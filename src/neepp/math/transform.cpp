@@ -1,5 +1,7 @@
 #include "neepp/math/transform.h"
 
+#include <cmath>
+
 #include <stdexcept>
 
 namespace neepp {
@@ -119,6 +121,16 @@ bool Transform::flips_handedness() const {
     float det = a[0][0] * (a[1][1] * a[2][2] - a[1][2] * a[2][1]) - a[0][1] * (a[1][0] * a[2][2] - a[1][2] * a[2][0]) +
                 a[0][2] * (a[1][0] * a[2][1] - a[1][1] * a[2][0]);
     return det < 0;
+}
+
+bool Transform::preserves_lengths() const {
+    for (int i = 0; i < 3; ++i)
+        for (int j = 0; j < 3; ++j) {
+            float d = 0;
+            for (int k = 0; k < 3; ++k) d += matrix.m[k][i] * matrix.m[k][j];
+            if (std::abs(d - (i == j ? 1.f : 0.f)) >= 1e-6f) return false;
+        }
+    return true;
 }
 
 }  // namespace neepp

@@ -29,16 +29,24 @@ struct Transform {
     Transform inverse() const { return {inverse_matrix, matrix}; }
 
     Vec3 point(const Vec3 &p) const;
-    // Inline: the environment map turns every direction it samples or looks up.
-    Vec3 vector(const Vec3 &v) const {
-        const auto &a = matrix.m;
-        return {a[0][0] * v.x + a[0][1] * v.y + a[0][2] * v.z, a[1][0] * v.x + a[1][1] * v.y + a[1][2] * v.z,
-                a[2][0] * v.x + a[2][1] * v.y + a[2][2] * v.z};
-    }
+    // Inline, with inverse_vector: the environment map turns every direction it samples or looks up.
+    Vec3 vector(const Vec3 &v) const { return linear(matrix, v); }
+    // The inverse's vector(v), from the inverse matrix kept here (inverse() would copy both matrices).
+    Vec3 inverse_vector(const Vec3 &v) const { return linear(inverse_matrix, v); }
     // Normals transform by the inverse transpose.
     Vec3 normal(const Vec3 &n) const;
     // Whether the transform flips orientation (negative determinant of the linear part).
     bool flips_handedness() const;
+    // Whether the linear part is a rotation, or one with a reflection (orthonormal columns, to 1e-6): then
+    // vector() keeps unit vectors unit.
+    bool preserves_lengths() const;
+
+private:
+    static Vec3 linear(const Matrix4 &m, const Vec3 &v) {
+        const auto &a = m.m;
+        return {a[0][0] * v.x + a[0][1] * v.y + a[0][2] * v.z, a[1][0] * v.x + a[1][1] * v.y + a[1][2] * v.z,
+                a[2][0] * v.x + a[2][1] * v.y + a[2][2] * v.z};
+    }
 };
 
 }  // namespace neepp
