@@ -2,8 +2,10 @@
 """Benchmark neepp `path` against Mitsuba 3 `llvm_ad_rgb` `path` on the evaluation scenes.
 
 For each scene (default: classroom 640x360, bathroom 512x512; always the reference's resolution and
-max_depth 17) both renderers render at the same spp, interleaved, `--reps` times with seeds 0..reps-1;
-the table gives medians (and the spread) of samples/s, the neepp/Mitsuba ratio, relMSE of each against
+max_depth 17) both renderers render at the same spp, interleaved (taking turns to go first), `--reps` times
+with seeds 0..reps-1; the table gives medians (and the spread) of samples/s, the neepp/Mitsuba ratio of each
+rep's pair of runs (median, range, geometric mean, and how many reps neepp won with the exact sign test's
+p, metrics.paired_ratios: one rep of a pair can fall either side of 1 on this machine), relMSE of each against
 ../shared/scenes/<scene>/reference/, the relative variance of each (from pairs of seeds, with 2+ reps:
 relMSE minus relVar is bias² plus the reference's own noise, so a relMSE gap with equal relVar is a
 bias), and peak memory (each process's own peak resident set, VmHWM: neepp's stats' peak_memory_mb;
@@ -113,35 +115,42 @@ def main(argv=None) -> int:
         ref = exr.read_exr(scenes_dir / scene / "reference" / REFERENCES[scene][3])
         runs = {"neepp": [], "mitsuba": []}
         images = {"neepp": [], "mitsuba": []}  # per rep, for relVar and the figures (the last rep's)
+        def render_neepp(rep):
+            r = runner.run_neepp(xml, out / f"{scene}_neepp_s{rep}.exr", spp=a.spp, resx=w, resy=h,
+                                 max_depth=a.max_depth, seed=rep, threads=a.threads or None,
+                                 integrator="path", binary=neepp, timeout=a.timeout)
+            st = r.stats
+            rt = st.get("render_time_s")
+            runs["neepp"].append({
+                "seed": rep, "render_time_s": rt, "load_time_s": st.get("load_time_s"), "wall_s": r.wall_s,
+                "samples_per_s": st.get("samples_per_s") or (w * h * a.spp / rt if rt else None),
+                "peak_memory_mb": st.get("peak_memory_mb"), "peak_rss_mb": r.peak_rss_mb,
+                "rays": st.get("rays"), "shadow_rays": st.get("shadow_rays"),
+                **metrics.all_metrics(r.image, ref)})
+            images["neepp"].append(r.image)
+            print(f"[{scene}] neepp   rep {rep}: {runs['neepp'][-1]['samples_per_s'] or 0:,.0f} samples/s, "
+                  f"relMSE {runs['neepp'][-1]['relmse']:.4g}", file=sys.stderr, flush=True)
+
+        def render_mitsuba(rep):
+            r = runner.run_mitsuba(xml, out / f"{scene}_mitsuba_s{rep}.exr", variant=a.variant, resx=w,
+                                   resy=h, spp=a.spp, max_depth=a.max_depth, seed=rep,
+                                   threads=a.threads, timeout=a.timeout)
+            st = r.stats
+            runs["mitsuba"].append({
+                "seed": rep, "render_time_s": st["render_time_s"], "load_time_s": st["load_time_s"],
+                "wall_s": r.wall_s, "samples_per_s": st["samples_per_s"],
+                "peak_memory_mb": st.get("peak_memory_mb", r.peak_rss_mb), "peak_rss_mb": r.peak_rss_mb,
+                **metrics.all_metrics(r.image, ref)})
+            images["mitsuba"].append(r.image)
+            print(f"[{scene}] mitsuba rep {rep}: {st['samples_per_s']:,.0f} samples/s, "
+                  f"relMSE {runs['mitsuba'][-1]['relmse']:.4g}", file=sys.stderr, flush=True)
+
+        renderers = ([render_neepp] if neepp is not None else []) + ([render_mitsuba] if use_mi else [])
         for rep in range(a.reps):
-            if neepp is not None:
-                r = runner.run_neepp(xml, out / f"{scene}_neepp_s{rep}.exr", spp=a.spp, resx=w, resy=h,
-                                     max_depth=a.max_depth, seed=rep, threads=a.threads or None,
-                                     integrator="path", binary=neepp, timeout=a.timeout)
-                st = r.stats
-                rt = st.get("render_time_s")
-                runs["neepp"].append({
-                    "seed": rep, "render_time_s": rt, "load_time_s": st.get("load_time_s"), "wall_s": r.wall_s,
-                    "samples_per_s": st.get("samples_per_s") or (w * h * a.spp / rt if rt else None),
-                    "peak_memory_mb": st.get("peak_memory_mb"), "peak_rss_mb": r.peak_rss_mb,
-                    "rays": st.get("rays"), "shadow_rays": st.get("shadow_rays"),
-                    **metrics.all_metrics(r.image, ref)})
-                images["neepp"].append(r.image)
-                print(f"[{scene}] neepp   rep {rep}: {runs['neepp'][-1]['samples_per_s'] or 0:,.0f} samples/s, "
-                      f"relMSE {runs['neepp'][-1]['relmse']:.4g}", file=sys.stderr, flush=True)
-            if use_mi:
-                r = runner.run_mitsuba(xml, out / f"{scene}_mitsuba_s{rep}.exr", variant=a.variant, resx=w,
-                                       resy=h, spp=a.spp, max_depth=a.max_depth, seed=rep,
-                                       threads=a.threads, timeout=a.timeout)
-                st = r.stats
-                runs["mitsuba"].append({
-                    "seed": rep, "render_time_s": st["render_time_s"], "load_time_s": st["load_time_s"],
-                    "wall_s": r.wall_s, "samples_per_s": st["samples_per_s"],
-                    "peak_memory_mb": st.get("peak_memory_mb", r.peak_rss_mb), "peak_rss_mb": r.peak_rss_mb,
-                    **metrics.all_metrics(r.image, ref)})
-                images["mitsuba"].append(r.image)
-                print(f"[{scene}] mitsuba rep {rep}: {st['samples_per_s']:,.0f} samples/s, "
-                      f"relMSE {runs['mitsuba'][-1]['relmse']:.4g}", file=sys.stderr, flush=True)
+            # The two renderers take turns going first, so that whatever a run leaves behind for the next
+            # (page cache, the other core's load, clock drift over the pair) falls on each alike.
+            for render_one in (renderers if rep % 2 == 0 else renderers[::-1]):
+                render_one(rep)
         summ = {}
         for k, rs in runs.items():
             if rs:
@@ -166,12 +175,17 @@ def main(argv=None) -> int:
         # ratio per repetition (the two renders of a rep ran back to back), then the median
         rep_ratios = [x["samples_per_s"] / y["samples_per_s"] for x, y in zip(runs["neepp"], runs["mitsuba"])
                       if x.get("samples_per_s") and y.get("samples_per_s")]
-        ratio = med(rep_ratios)
+        paired = metrics.paired_ratios(rep_ratios)
+        ratio = paired["median"]
         summ["ratio_per_rep"] = rep_ratios
+        summ["ratio_summary"] = paired
         msps = lambda v: v / 1e6 if v else None  # noqa: E731
         rows.append({"scene": f"{scene} {w}x{h}", "neepp_sps": msps(n.get("samples_per_s")),
                      "mi_sps": msps(m.get("samples_per_s")), "ratio": ratio,
                      "ratio_range": (f"{min(rep_ratios):.3g}-{max(rep_ratios):.3g}" if len(rep_ratios) > 1 else None),
+                     "ratio_geomean": paired["geomean"],
+                     "ratio_above_1": (f"{paired['above_1']}/{paired['n']} (p={paired['sign_test_p']:.3g})"
+                                       if paired["n"] > 1 else None),
                      "neepp_relmse": n.get("relmse"), "mi_relmse": m.get("relmse"),
                      "neepp_relvar": n.get("relvar"), "mi_relvar": m.get("relvar"),
                      "neepp_mean": n.get("mean_ratio"), "mi_mean": m.get("mean_ratio"),
@@ -192,7 +206,8 @@ def main(argv=None) -> int:
     results["loadavg_end"] = os.getloadavg()
 
     headers = {"scene": "scene", "neepp_sps": "neepp M samples/s", "mi_sps": f"Mitsuba {a.variant} M samples/s",
-               "ratio": "ratio neepp/Mitsuba", "ratio_range": "ratio range", "neepp_relmse": "neepp relMSE", "mi_relmse": "Mitsuba relMSE",
+               "ratio": "ratio neepp/Mitsuba", "ratio_range": "ratio range", "ratio_geomean": "ratio geomean",
+               "ratio_above_1": "reps neepp faster (sign test p)", "neepp_relmse": "neepp relMSE", "mi_relmse": "Mitsuba relMSE",
                "neepp_relvar": "neepp relVar", "mi_relvar": "Mitsuba relVar",
                "neepp_mean": "neepp mean/ref", "mi_mean": "Mitsuba mean/ref",
                "neepp_mem": "neepp peak MB", "mi_mem": "Mitsuba peak MB",

@@ -6,6 +6,8 @@
 """
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 EPS = 0.01
@@ -100,3 +102,22 @@ def all_metrics(img, ref) -> dict:
         "mean_stderr": mean_stderr(img, ref),
         "relmse_stderr": relmse_stderr(img, ref),
     }
+
+
+def paired_ratios(ratios) -> dict:
+    """Summary of per-repetition speed ratios (a / b, each from two runs taken back to back).
+
+    On a noisy machine one repetition can land on either side of 1 whatever the true ratio, so beside the
+    median this gives the geometric mean (the mean of log ratios: a 2x and a 0.5x cancel) and an exact
+    one-sided sign test: the probability of at least this many ratios above 1 if a and b were equally fast
+    (each repetition then a coin toss). It assumes nothing about the noise's distribution; five
+    repetitions all above 1 give p = 1/32.
+    """
+    rs = [float(r) for r in ratios if r is not None and r > 0 and math.isfinite(r)]
+    n = len(rs)
+    if n == 0:
+        return {"n": 0, "median": None, "geomean": None, "above_1": 0, "sign_test_p": None}
+    above = sum(r > 1 for r in rs)
+    p = sum(math.comb(n, k) for k in range(above, n + 1)) / 2**n
+    return {"n": n, "median": float(np.median(rs)), "geomean": math.exp(sum(map(math.log, rs)) / n),
+            "above_1": above, "sign_test_p": p}

@@ -78,3 +78,16 @@ def test_relative_variance_matches_known_noise():
     # A common offset (bias, which relmse against the reference would count) is invisible to it.
     assert metrics.relative_variance(a + 1, b + 1, ref) == pytest.approx(metrics.relative_variance(a, b, ref))
     assert metrics.relative_variance(a, a, ref) == 0
+
+
+def test_paired_ratios_summary_and_sign_test():
+    s = metrics.paired_ratios([2.0, 0.5, 1.5, 1.2, 1.1])
+    assert s["n"] == 5 and s["above_1"] == 4
+    assert s["median"] == pytest.approx(1.2)
+    assert s["geomean"] == pytest.approx((2.0 * 0.5 * 1.5 * 1.2 * 1.1) ** (1 / 5))
+    assert s["sign_test_p"] == pytest.approx(6 / 32)  # P(X >= 4), X ~ Binomial(5, 1/2)
+    assert metrics.paired_ratios([1.1] * 5)["sign_test_p"] == pytest.approx(1 / 32)
+    assert metrics.paired_ratios([0.9, 0.8])["sign_test_p"] == pytest.approx(1.0)
+    # A 2x and a 0.5x cancel in the geometric mean; unusable entries are left out.
+    assert metrics.paired_ratios([2.0, 0.5, None, float("nan")])["geomean"] == pytest.approx(1.0)
+    assert metrics.paired_ratios([])["n"] == 0
