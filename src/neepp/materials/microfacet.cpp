@@ -179,32 +179,34 @@ struct Quadrature {
     std::vector<float> nodes, weights;
 };
 
+// P_n(x) by the three-term recurrence, and its derivative from P_n and P_{n-1}.
+struct Legendre {
+    double value, derivative;
+};
+Legendre legendre(int n, double x) {
+    double p0 = 1, p1 = x;
+    for (int k = 2; k <= n; ++k) {
+        double p2 = ((2.0 * k - 1.0) * x * p1 - (k - 1.0) * p0) / k;
+        p0 = p1;
+        p1 = p2;
+    }
+    return {p1, n * (x * p1 - p0) / (x * x - 1.0)};
+}
+
 Quadrature gauss_legendre(int n) {
     Quadrature q;
     q.nodes.resize(n);
     q.weights.resize(n);
     for (int i = 0; i < n; ++i) {
-        double x = -std::cos((2.0 * i + 1.0) / (2.0 * n) * 3.14159265358979323846), dp = 0;
+        double x = -std::cos((2.0 * i + 1.0) / (2.0 * n) * 3.14159265358979323846);
         for (int it = 0; it < 100; ++it) {
-            double p0 = 1, p1 = x;
-            for (int k = 2; k <= n; ++k) {
-                double p2 = ((2.0 * k - 1.0) * x * p1 - (k - 1.0) * p0) / k;
-                p0 = p1;
-                p1 = p2;
-            }
-            dp = n * (x * p1 - p0) / (x * x - 1.0);
-            double step = p1 / dp;
+            const Legendre p = legendre(n, x);
+            double step = p.value / p.derivative;
             x -= step;
             if (std::abs(step) < 1e-15) break;
         }
-        // Recompute the derivative at the converged node.
-        double p0 = 1, p1 = x;
-        for (int k = 2; k <= n; ++k) {
-            double p2 = ((2.0 * k - 1.0) * x * p1 - (k - 1.0) * p0) / k;
-            p0 = p1;
-            p1 = p2;
-        }
-        dp = n * (x * p1 - p0) / (x * x - 1.0);
+        // The derivative at the converged node.
+        const double dp = legendre(n, x).derivative;
         q.nodes[i] = float(x);
         q.weights[i] = float(2.0 / ((1.0 - x * x) * dp * dp));
     }

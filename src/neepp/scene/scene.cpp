@@ -78,12 +78,18 @@ void to_embree_packet(const Ray *const *rays, int n, RaysW &r, int *valid) {
     }
 }
 
-// Up to 16 rays as packets of W.
-template <int W>
-void intersect_packets(RTCScene scene, const Ray *const *rays, RayHit *const *hits, int n, bool coherent) {
+// A query context; coherent asks for Embree's traversal for rays that leave one pixel or a few neighbours.
+RTCIntersectContext intersect_context(bool coherent) {
     RTCIntersectContext ctx;
     rtcInitIntersectContext(&ctx);
     if (coherent) ctx.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
+    return ctx;
+}
+
+// Up to 16 rays as packets of W.
+template <int W>
+void intersect_packets(RTCScene scene, const Ray *const *rays, RayHit *const *hits, int n, bool coherent) {
+    RTCIntersectContext ctx = intersect_context(coherent);
     for (int b = 0; b < n; b += W) {
         const int m = std::min(W, n - b);
         alignas(64) int valid[W];
@@ -104,9 +110,7 @@ void intersect_packets(RTCScene scene, const Ray *const *rays, RayHit *const *hi
 
 template <int W>
 void occluded_packets(RTCScene scene, const Ray *const *rays, int n, bool *occluded, bool coherent) {
-    RTCIntersectContext ctx;
-    rtcInitIntersectContext(&ctx);
-    if (coherent) ctx.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
+    RTCIntersectContext ctx = intersect_context(coherent);
     for (int b = 0; b < n; b += W) {
         const int m = std::min(W, n - b);
         alignas(64) int valid[W];
@@ -215,8 +219,7 @@ void Scene::build() {
 }
 
 RayHit Scene::trace(const Ray &ray) const {
-    RTCIntersectContext ctx;
-    rtcInitIntersectContext(&ctx);
+    RTCIntersectContext ctx = intersect_context(false);
     RTCRayHit rh;
     to_embree(ray, rh.ray);
     rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
@@ -248,8 +251,7 @@ void Scene::occluded16(const Ray *const *rays, int n, bool *occluded, bool coher
 }
 
 bool Scene::occluded(const Ray &ray) const {
-    RTCIntersectContext ctx;
-    rtcInitIntersectContext(&ctx);
+    RTCIntersectContext ctx = intersect_context(false);
     RTCRay r;
     to_embree(ray, r);
     rtcOccluded1(rtc_scene_, &ctx, &r);
