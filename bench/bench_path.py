@@ -115,6 +115,7 @@ def main(argv=None) -> int:
         ref = exr.read_exr(scenes_dir / scene / "reference" / REFERENCES[scene][3])
         runs = {"neepp": [], "mitsuba": []}
         images = {"neepp": [], "mitsuba": []}  # per rep, for relVar and the figures (the last rep's)
+
         def render_neepp(rep):
             r = runner.run_neepp(xml, out / f"{scene}_neepp_s{rep}.exr", spp=a.spp, resx=w, resy=h,
                                  max_depth=a.max_depth, seed=rep, threads=a.threads or None,

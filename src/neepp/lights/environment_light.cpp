@@ -14,7 +14,7 @@
 namespace neepp {
 
 EnvironmentMapLight::EnvironmentMapLight(Image image, const Transform &to_world, float scale)
-    : to_world_(to_world), rotation_(to_world.preserves_lengths()), scale_(scale) {
+    : to_world_(to_world), keeps_lengths_(to_world.preserves_lengths()), scale_(scale) {
     width_ = image.width, height_ = image.height;
     if (image.width < 2 || image.height < 2) throw std::runtime_error("envmap: image too small");
     const int w = width_, h = height_;
@@ -133,7 +133,7 @@ Vec3 EnvironmentMapLight::uv_to_direction(Vec2 uv, float *sin_theta) const {
     const SinCos t = sincos_turns(0.5f * uv.y), p = sincos_turns(uv.x);
     if (sin_theta) *sin_theta = t.sin;
     const Vec3 d = to_world_.vector(Vec3(t.sin * p.sin, t.cos, -t.sin * p.cos));  // unit before to_world
-    return rotation_ ? d : normalize(d);
+    return keeps_lengths_ ? d : normalize(d);
 }
 
 Color EnvironmentMapLight::texel(size_t index) const {

@@ -57,7 +57,7 @@ private:
     Transform to_world_;
     // to_world_ keeps lengths (an envmap's to_world is a rotation, or the identity, in practice): the
     // directions it turns need no normalizing.
-    bool rotation_ = false;
+    bool keeps_lengths_ = false;
     float scale_;
     static constexpr int kMaxSampleWidth = 1024;
     AliasTable cells_;  // sampling cells (texel cells merged down to at most 1024x512), ∝ luminance × sin(theta)
