@@ -15,7 +15,8 @@ integrator) and the rest (libc, libm, TBB).
     .venv/bin/python bench/instructions.py bathroom --res 96 --top 40
     .venv/bin/python bench/instructions.py cornell-box --bin-b build-ab/neepp   # A/B of two binaries
 
-Needs valgrind (`apt install valgrind`). Runs on one thread; takes about a minute at the defaults.
+Needs valgrind (`apt install valgrind`), and on a CPU with AVX-512 a binary valgrind can run:
+scripts/build_valgrind.sh builds one (build-valgrind/neepp, for x86-64-v3); pass it as --bin. Runs on one thread; takes about a minute at the defaults.
 Writes bench/out/instructions/ (git-ignored): report.md, results.json.
 """
 from __future__ import annotations
@@ -93,6 +94,23 @@ def group_of(label: str) -> str:
     return "Embree" if "embree" in label else "neepp" if label == "neepp" else "other"
 
 
+def valgrind_problem(binary: Path) -> str | None:
+    """Why valgrind cannot run `binary`, or None when it can.
+
+    Valgrind decodes no AVX-512: a -march=native build on such a CPU (any Xeon since Skylake-SP) dies under it
+    with SIGILL, already in its static initialisers. scripts/build_valgrind.sh builds a neepp that runs under
+    valgrind everywhere (x86-64-v3)."""
+    r = subprocess.run(["valgrind", "--tool=none", str(binary), "--help"], capture_output=True, text=True,
+                       env=dict(os.environ, NEEPP_NO_HUGE_PAGES="1"))
+    if r.returncode == 0:
+        return None
+    if "SIGILL" in r.stderr or "unhandled instruction" in r.stderr or r.returncode == 128 + 4:
+        return (f"valgrind cannot run {binary}: it contains instructions valgrind does not decode (AVX-512, "
+                f"from -march=native on this CPU); build one that it can run with scripts/build_valgrind.sh "
+                f"and pass --bin build-valgrind/neepp")
+    return f"valgrind could not run {binary} --help (exit {r.returncode}):\n{r.stderr[-2000:]}"
+
+
 def callgrind_render(binary: Path, scene: Path, res: int, spp: int, max_depth: int, workdir: Path) -> Counter:
     out = workdir / f"callgrind_{spp}.out"
     cmd = ["valgrind", "--tool=callgrind", f"--callgrind-out-file={out}", str(binary), "render", str(scene),
@@ -149,6 +167,10 @@ def main(argv=None) -> int:
         print("neepp binary not found (--bin, NEEPP_BIN or build/neepp)", file=sys.stderr)
         return 2
     binaries = {"A": bin_a} | ({"B": Path(a.bin_b)} if a.bin_b else {})
+    for b in binaries.values():
+        if (why := valgrind_problem(b)) is not None:
+            print(why, file=sys.stderr)
+            return 2
     out = Path(a.out)
     out.mkdir(parents=True, exist_ok=True)
     with tempfile.TemporaryDirectory(prefix="neepp_callgrind_") as tmp:

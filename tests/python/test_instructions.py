@@ -3,7 +3,9 @@ from __future__ import annotations
 
 import importlib.util
 import json
+import os
 import shutil
+import subprocess
 from pathlib import Path
 
 import pytest
@@ -69,8 +71,37 @@ def test_object_labels_line_two_binaries_up():
     assert instructions.group_of("libc.so.6") == "other"
 
 
-@pytest.mark.skipif(shutil.which("valgrind") is None, reason="valgrind not installed (scripts/test.sh installs it)")
-def test_counts_a_render_of_the_project_scene(neepp_bin, tmp_path):
+needs_valgrind = pytest.mark.skipif(shutil.which("valgrind") is None,
+                                    reason="valgrind not installed (scripts/test.sh installs it)")
+
+
+@pytest.fixture(scope="session")
+def valgrind_bin(neepp_bin) -> Path:
+    """A neepp valgrind can run on this CPU: build-valgrind/neepp (x86-64-v3, scripts/build_valgrind.sh, which
+    scripts/test.sh runs), else the ordinary build where valgrind can run it (no AVX-512 in it)."""
+    for b in (os.environ.get("NEEPP_VALGRIND_BIN"), REPO / "build-valgrind" / "neepp", neepp_bin):
+        if b and Path(b).exists() and instructions.valgrind_problem(Path(b)) is None:
+            return Path(b)
+    pytest.skip("no neepp that valgrind can run on this CPU: run scripts/build_valgrind.sh")
+
+
+@needs_valgrind
+def test_a_binary_valgrind_cannot_decode_is_named_not_crashed_on(tmp_path):
+    # One AVX-512 instruction, which valgrind decodes on no CPU: what a -march=native build on an AVX-512
+    # machine holds. The check must say so (and name the way out), on any CPU, instead of a crash mid-run.
+    src = tmp_path / "avx512.c"
+    src.write_text('int main(void) { __asm__ volatile("vpxorq %zmm0, %zmm0, %zmm0"); return 0; }\n')
+    exe = tmp_path / "avx512"
+    subprocess.run(["cc", "-o", str(exe), str(src)], check=True)
+    why = instructions.valgrind_problem(exe)
+    assert why is not None and "build_valgrind.sh" in why
+    assert instructions.main([str(REPO / "scenes" / "door-ajar" / "scene.xml"), "--bin", str(exe),
+                              "--out", str(tmp_path / "out")]) == 2
+
+
+@needs_valgrind
+def test_counts_a_render_of_the_project_scene(valgrind_bin, tmp_path):
+    neepp_bin = valgrind_bin
     scene = REPO / "scenes" / "door-ajar" / "scene.xml"
     rc = instructions.main([str(scene), "--bin", str(neepp_bin), "--res", "16", "--spp", "1,2",
                             "--max-depth", "5", "--top", "5", "--out", str(tmp_path)])
