@@ -39,6 +39,7 @@ struct FurnaceCase {
     std::string name;
     std::map<std::string, std::string> options;
     std::string sampler = "independent";
+    std::string integrator = "path";
 };
 
 void PrintTo(const FurnaceCase &c, std::ostream *os) { *os << c.name; }
@@ -49,7 +50,7 @@ TEST_P(Furnace, InnerSphereMatchesGeometricSeries) {
     const float rho = 0.7f, le = 0.5f;
     for (int max_depth : {1, 2, 3, 8, -1}) {
         std::string path = write_temp_scene(inner_furnace_xml(rho, le, max_depth));
-        auto out = render_scene_file(path, 64, 7, Options(GetParam().options), "path", GetParam().sampler);
+        auto out = render_scene_file(path, 64, 7, Options(GetParam().options), GetParam().integrator, GetParam().sampler);
         double expected = expected_furnace(rho, le, max_depth);
         auto st = pixel_statistics(out.image, 1);
         // max_depth 1 and 2 are deterministic up to float rounding and the ray offset; deeper paths are
@@ -66,12 +67,18 @@ INSTANTIATE_TEST_SUITE_P(PathModes, Furnace,
                                            FurnaceCase{"nee_uniform", {{"light_sampler", "uniform"}}},
                                            FurnaceCase{"bsdf_only", {{"nee", "false"}}},
                                            FurnaceCase{"rr_early", {{"rr_depth", "1"}}},
-                                           FurnaceCase{"sobol_sampler", {}, "sobol"}),
+                                           FurnaceCase{"sobol_sampler", {}, "sobol"},
+                                           FurnaceCase{"bdpt", {}, "independent", "bdpt"},
+                                           FurnaceCase{"bdpt_balance", {{"mis", "balance"}}, "independent", "bdpt"},
+                                           FurnaceCase{"bdpt_neepp", {{"light_paths", "neepp"}, {"pool", "512"}, {"candidates", "4"}},
+                                                       "independent", "bdpt"},
+                                           FurnaceCase{"light", {}, "independent", "light"}),
                          [](const auto &info) { return info.param.name; });
 
 // A convex diffuse object under a constant environment of radiance 1 reflects exactly its albedo.
 TEST(Furnace, DiffuseSphereUnderConstantEnvironment) {
-    for (bool nee : {true, false}) {
+    for (const char *integrator : {"path", "path_bsdf", "bdpt", "light"}) {
+        const bool nee = std::string(integrator) != "path_bsdf";
         std::string xml = R"(<scene version="3.0.0">
   <sensor type="perspective">
     <float name="fov" value="10"/>
@@ -82,12 +89,15 @@ TEST(Furnace, DiffuseSphereUnderConstantEnvironment) {
     <bsdf type="diffuse"><rgb name="reflectance" value="0.6, 0.3, 0.9"/></bsdf></shape>
   <emitter type="constant"><rgb name="radiance" value="1"/></emitter>
 </scene>)";
-        auto out = render_scene_file(write_temp_scene(xml), 256, 3, Options(OptionMap{{"nee", nee ? "true" : "false"}, {"max_depth", "2"}}));
+        const std::string name = nee ? integrator : "path";
+        Options o(OptionMap{{"max_depth", "2"}});
+        if (name == "path") o.set("nee", nee ? "true" : "false");
+        auto out = render_scene_file(write_temp_scene(xml), 256, 3, o, name);
         // The 8x8 image at fov 10 from distance 10 sees only the sphere (half-width 0.87 < 1.5).
         const float expected[3] = {0.6f, 0.3f, 0.9f};
         for (int c = 0; c < 3; ++c) {
             auto st = pixel_statistics(out.image, c);
-            EXPECT_NEAR(st.mean, expected[c], 5 * st.stderr_ + 1e-4) << "nee=" << nee << " channel " << c;
+            EXPECT_NEAR(st.mean, expected[c], 5 * st.stderr_ + 1e-4) << integrator << " channel " << c;
         }
     }
 }

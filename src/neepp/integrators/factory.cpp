@@ -1,9 +1,86 @@
+#include <sstream>
 #include <stdexcept>
+#include "neepp/integrators/bdpt.h"
 #include "neepp/integrators/path.h"
 #include "neepp/light_selection/factory.h"
 #include "neepp/visibility/neepp_shadow_rays.h"
 
 namespace neepp {
+
+// The shadow-ray component every integrator traces its shadow rays and connections through, from the
+// options they share: nee traces every shadow ray; the neepp* policies (NEE++) play Russian roulette
+// driven by a visibility map. Their options are only accepted with them (or when the integrator needs a
+// map anyway), so a typo'd or meaningless option is still reported as unused.
+std::unique_ptr<ShadowRayTester> make_shadow_ray_tester(const Options &options, bool needs_map, int voxels,
+                                                        bool defer_seeding) {
+    std::string policy = options.get_string("shadow_rays", "nee");
+    if (policy == "nee" && !needs_map) return std::make_unique<TraceAllShadowRays>();
+    NeeppOptions n;
+    n.policy = parse_shadow_ray_policy(policy);
+    n.voxels = voxels;
+    n.samples_per_pair = options.get_int("samples_per_pair", n.samples_per_pair);
+    n.q_min = options.get_float("q_min", n.q_min);
+    n.map_file = options.get_string("visibility_map", n.map_file);
+    n.learn = options.get_bool("learn", n.learn);
+    n.learn_until = options.get_int("learn_until", n.learn_until);
+    if (n.learn_until < 1) throw std::invalid_argument("learn_until must be at least 1");
+    n.min_occluded = options.get_float("min_occluded", n.min_occluded);
+    n.defer_seeding = defer_seeding;
+    if (!(n.min_occluded >= 0.f && n.min_occluded <= 1.f)) throw std::invalid_argument("min_occluded must be in [0, 1]");
+    if (n.policy == ShadowRayPolicy::NeeppAdaptive) {
+        n.adaptive_target = options.get_string("adaptive_target", n.adaptive_target);
+        n.shadow_ray_cost = options.get_float("shadow_ray_cost", n.shadow_ray_cost);
+        if (n.adaptive_target != "efficiency" && n.adaptive_target != "rays")
+            throw std::invalid_argument("adaptive_target must be 'efficiency' or 'rays'");
+        if (!(n.shadow_ray_cost > 0 && n.shadow_ray_cost <= 1))
+            throw std::invalid_argument("shadow_ray_cost must be in (0, 1]");
+    }
+    return std::make_unique<NeeppShadowRays>(n);
+}
+
+namespace {
+
+std::unique_ptr<Integrator> make_bdpt(bool light_tracer, const Options &options) {
+    BDPTOptions o;
+    o.light_tracer = light_tracer;
+    o.max_depth = options.get_int("max_depth", o.max_depth);
+    o.rr_depth = options.get_int("rr_depth", o.rr_depth);
+    o.hide_emitters = options.get_bool("hide_emitters", o.hide_emitters);
+    if (o.max_depth < -1 || o.max_depth == 0) throw std::invalid_argument("max_depth must be -1 or >= 1");
+    if (o.rr_depth < 1) throw std::invalid_argument("rr_depth must be >= 1");
+    if (!light_tracer) {
+        if (options.has("strategy")) {
+            const std::string st = options.get_string("strategy", "");
+            char comma = 0;
+            std::istringstream in(st);
+            if (!(in >> o.strategy_s >> comma >> o.strategy_t) || comma != ',' || !in.eof() || o.strategy_s < 0 ||
+                o.strategy_t < 1)
+                throw std::invalid_argument("option 'strategy': '" + st + "' is not S,T with S >= 0 and T >= 1");
+            const std::string w = options.get_string("strategy_weight", "mis");
+            if (w != "mis" && w != "none") throw std::invalid_argument("strategy_weight must be 'mis' or 'none'");
+            o.strategy_mis = w == "mis";
+        }
+        const std::string mis = options.get_string("mis", "power");
+        if (mis != "power" && mis != "balance") throw std::invalid_argument("mis must be 'power' or 'balance'");
+        o.power_heuristic = mis == "power";
+        const std::string lp = options.get_string("light_paths", "independent");
+        if (lp != "independent" && lp != "neepp")
+            throw std::invalid_argument("light_paths must be 'independent' or 'neepp'");
+        o.neepp_selection = lp == "neepp";
+        if (o.neepp_selection) {
+            o.candidates = options.get_int("candidates", o.candidates);
+            o.pool = options.get_int("pool", o.pool);
+            if (o.candidates < 1 || o.candidates > 64) throw std::invalid_argument("candidates must be in [1, 64]");
+            if (o.pool < 1) throw std::invalid_argument("pool must be at least 1");
+        }
+    }
+    const bool needs_map = o.neepp_selection;
+    if (needs_map || options.get_string("shadow_rays", "nee") != "nee") o.voxels = options.get_int("voxels", o.voxels);
+    auto shadow = make_shadow_ray_tester(options, needs_map, o.voxels, !needs_map);
+    return std::make_unique<BDPTIntegrator>(o, std::move(shadow));
+}
+
+}  // namespace
 
 std::unique_ptr<Integrator> make_integrator(const std::string &name, const Options &options) {
     std::unique_ptr<Integrator> integrator;
@@ -17,41 +94,16 @@ std::unique_ptr<Integrator> make_integrator(const std::string &name, const Optio
         check_light_sampler_name(o.light_sampler);
         if (o.max_depth < -1 || o.max_depth == 0) throw std::invalid_argument("max_depth must be -1 or >= 1");
         if (o.rr_depth < 1) throw std::invalid_argument("rr_depth must be >= 1");
-        // Shadow-ray policy: nee traces every shadow ray; the neepp* policies (NEE++) play Russian roulette
-        // driven by a visibility map. Their options are only accepted with them (or with a light sampler
-        // that reads the map), so a typo'd or meaningless option is still reported as unused.
-        std::string policy = options.get_string("shadow_rays", "nee");
         const bool needs_map = light_sampler_needs_visibility_map(o.light_sampler);
-        if (o.light_sampler.rfind("spatial", 0) == 0 || needs_map || policy != "nee") o.voxels = options.get_int("voxels", o.voxels);
-        std::unique_ptr<ShadowRayTester> shadow;
-        if (policy == "nee" && !needs_map) {
-            shadow = std::make_unique<TraceAllShadowRays>();
-        } else {
-            NeeppOptions n;
-            n.policy = parse_shadow_ray_policy(policy);
-            n.voxels = o.voxels;
-            n.samples_per_pair = options.get_int("samples_per_pair", n.samples_per_pair);
-            n.q_min = options.get_float("q_min", n.q_min);
-            n.map_file = options.get_string("visibility_map", n.map_file);
-            n.learn = options.get_bool("learn", n.learn);
-            n.learn_until = options.get_int("learn_until", n.learn_until);
-            if (n.learn_until < 1) throw std::invalid_argument("learn_until must be at least 1");
-            n.min_occluded = options.get_float("min_occluded", n.min_occluded);
-            n.defer_seeding = !needs_map;  // a light sampler reading the map needs it from the first pass
-            if (!(n.min_occluded >= 0.f && n.min_occluded <= 1.f)) throw std::invalid_argument("min_occluded must be in [0, 1]");
-            if (n.policy == ShadowRayPolicy::NeeppAdaptive) {
-                n.adaptive_target = options.get_string("adaptive_target", n.adaptive_target);
-                n.shadow_ray_cost = options.get_float("shadow_ray_cost", n.shadow_ray_cost);
-                if (n.adaptive_target != "efficiency" && n.adaptive_target != "rays")
-                    throw std::invalid_argument("adaptive_target must be 'efficiency' or 'rays'");
-                if (!(n.shadow_ray_cost > 0 && n.shadow_ray_cost <= 1))
-                    throw std::invalid_argument("shadow_ray_cost must be in (0, 1]");
-            }
-            shadow = std::make_unique<NeeppShadowRays>(n);
-        }
+        if (o.light_sampler.rfind("spatial", 0) == 0 || needs_map || options.get_string("shadow_rays", "nee") != "nee")
+            o.voxels = options.get_int("voxels", o.voxels);
+        // A light sampler reading the map needs it from the first pass: no deferred seeding then.
+        std::unique_ptr<ShadowRayTester> shadow = make_shadow_ray_tester(options, needs_map, o.voxels, !needs_map);
         integrator = std::make_unique<PathIntegrator>(o, std::move(shadow));
+    } else if (name == "bdpt" || name == "light") {
+        integrator = make_bdpt(name == "light", options);
     } else {
-        throw std::invalid_argument("unknown integrator '" + name + "' (supported: path)");
+        throw std::invalid_argument("unknown integrator '" + name + "' (supported: path, bdpt, light)");
     }
     if (auto unused = options.unused(); !unused.empty()) {
         std::string list;

@@ -15,6 +15,16 @@ namespace neepp {
 
 class Scene;
 class Sampler;
+class SplatFilm;
+
+// What the render loop tells an integrator before a pass.
+struct PassInfo {
+    int pass_index = 0;
+    int spp = 0;                // samples per pixel completed before this pass
+    int size = 0;               // samples per pixel this pass adds
+    uint64_t camera_samples = 0;  // pixels × size
+    uint64_t seed = 0;
+};
 
 class Integrator {
 public:
@@ -29,6 +39,23 @@ public:
                           std::span<Color> out, RenderCounters &counters) const {
         for (size_t i = 0; i < rays.size(); ++i) out[i] = Li(scene, rays[i], *samplers[i], counters);
     }
+    // Integrators whose samples also add to other pixels than their own (light tracing, BDPT's t = 1
+    // strategies) say so; the render loop then calls Li_splat, one sample at a time, with the pass's splat
+    // film, and adds the splats to the image scaled by pixels / light paths.
+    virtual bool splats() const { return false; }
+    virtual Color Li_splat(const Scene &scene, const Ray &ray, Sampler &sampler, RenderCounters &counters,
+                           SplatFilm &splats) const {
+        return Li(scene, ray, sampler, counters);
+    }
+    // Light paths whose camera connections each camera sample splats (1: its own light path; 0 when the
+    // light paths are traced apart, before the pass, as BDPT's NEE++ pool is).
+    virtual double light_paths_per_sample() const { return 1; }
+    // Called before each pass, from the render loop's thread arena (it may run in parallel inside): BDPT's
+    // NEE++ selection traces its pool of light paths here. Returns how many light paths it splatted into
+    // `splats`, which count toward the splats' normalization.
+    virtual uint64_t begin_pass(const Scene &scene, const PassInfo &pass, SplatFilm &splats, RenderCounters &counters) {
+        return 0;
+    }
     // Called between passes, single-threaded, after all samples of the pass are in.
     virtual void end_pass(const Scene &scene, const PassStatistics &pass) {}
     // Whether end_pass changes what later samples do (NEE++ publishes a new map): the render loop then
@@ -40,7 +67,14 @@ public:
     virtual nlohmann::json statistics() const { return nlohmann::json::object(); }
 };
 
-// Creates an integrator by name ("path") from its options; throws on unknown names or unused options.
+class ShadowRayTester;
+// The shadow-ray component of an integrator, from the options every integrator shares (shadow_rays and
+// NEE++'s options): one that keeps a visibility map when the policy reads one or needs_map says the
+// integrator does (visibility-aware light selection, BDPT's light-path selection).
+std::unique_ptr<ShadowRayTester> make_shadow_ray_tester(const Options &options, bool needs_map, int voxels,
+                                                        bool defer_seeding);
+
+// Creates an integrator by name (path, bdpt, light) from its options; throws on unknown names or unused options.
 std::unique_ptr<Integrator> make_integrator(const std::string &name, const Options &options);
 
 }  // namespace neepp

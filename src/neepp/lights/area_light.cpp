@@ -1,5 +1,7 @@
 #include "neepp/lights/area_light.h"
 
+#include "neepp/math/warp.h"
+
 namespace neepp {
 
 DirectionSample AreaLight::sample_direction(const Vec3 &ref, Vec2 u, Color &radiance) const {
@@ -40,6 +42,36 @@ void AreaLight::prepare(const BBox &) {
 float AreaLight::pdf_direction(const Vec3 &ref, const DirectionSample &ds) const {
     if (!emits_toward(ds)) return 0.f;
     return shape_->pdf_position() * ds.dist * ds.dist / std::abs(dot(ds.n, ds.d));
+}
+
+EmissionSample AreaLight::sample_emission(Vec2 u_pos, Vec2 u_dir) const {
+    const PositionSample ps = shape_->sample_position(u_pos, !constant_);
+    EmissionSample es;
+    es.p = ps.p;
+    es.n = ps.n;
+    es.ns = ps.ns;
+    es.uv = ps.uv;
+    const Frame frame(ps.ns);
+    const Vec3 local = square_to_cosine_hemisphere(u_dir);
+    const Vec3 d = frame.to_world(local);
+    es.ray = spawn_ray(ps.p, ps.n, d);
+    es.pdf_pos = ps.pdf;
+    es.pdf_dir = square_to_cosine_hemisphere_pdf(local);
+    if (!(es.pdf_dir > 0) || dot(ps.n, d) == 0.f) return es;
+    if (constant_) {
+        es.radiance = constant_radiance_;
+    } else {
+        SurfaceInteraction si;
+        si.p = ps.p; si.n = ps.n; si.uv = ps.uv;
+        es.radiance = radiance_->eval(si);
+    }
+    return es;
+}
+
+EmissionDensity AreaLight::pdf_emission(const Vec3 &, const Vec3 &n, const Vec3 &ns, const Vec3 &w) const {
+    const float cos_s = dot(ns, w);
+    if (!(cos_s > 0) || dot(n, w) == 0.f) return {};
+    return {shape_->pdf_position(), cos_s * kInvPi};
 }
 
 Color AreaLight::eval_surface(const SurfaceInteraction &si, const Vec3 &w) const {

@@ -20,6 +20,9 @@ public:
     DirectionSample sample_direction(const Vec3 &ref, Vec2 u, Color &radiance) const override;
     float pdf_direction(const Vec3 &ref, const DirectionSample &ds) const override;
     Color eval_surface(const SurfaceInteraction &si, const Vec3 &w) const override;
+    // A point by area, a direction cosine-distributed about its shading normal (the side that emits).
+    EmissionSample sample_emission(Vec2 u_pos, Vec2 u_dir) const override;
+    EmissionDensity pdf_emission(const Vec3 &p, const Vec3 &n, const Vec3 &ns, const Vec3 &w) const override;
     Color power() const override { return radiance_->mean() * (kPi * shape_->surface_area()); }
     // The shape's box, a cone around its face and vertex normals, one-sided cosine emission.
     std::optional<LightBounds> bounds() const override;

@@ -221,7 +221,7 @@ DirectionSample EnvironmentMapLight::finish_sample(const Vec3 &ref, const LightS
     ds.d = d;
     ds.pdf = pdf_uv / (2.f * kPi * kPi * sin_theta);
     ds.dist = kInfinity;
-    ds.p = ref + ds.d * (4.f * scene_radius_);
+    ds.p = ref + ds.d * (4.f * sphere_.radius);
     radiance = lookup(uv) * scale_;
     return ds;
 }
@@ -240,7 +240,7 @@ float EnvironmentMapLight::pdf_direction(const Vec3 &, const DirectionSample &ds
 }
 
 Color EnvironmentMapLight::power() const {
-    return mean_radiance_ * (kPi * 4.f * kPi * scene_radius_ * scene_radius_);
+    return mean_radiance_ * (kPi * 4.f * kPi * sphere_.radius * sphere_.radius);
 }
 
 DirectionSample ConstantEnvironmentLight::sample_direction(const Vec3 &ref, Vec2 u, Color &radiance) const {
@@ -248,7 +248,7 @@ DirectionSample ConstantEnvironmentLight::sample_direction(const Vec3 &ref, Vec2
     ds.d = square_to_uniform_sphere(u);
     ds.pdf = kInv4Pi;
     ds.dist = kInfinity;
-    ds.p = ref + ds.d * (4.f * scene_radius_);
+    ds.p = ref + ds.d * (4.f * sphere_.radius);
     radiance = radiance_;
     return ds;
 }
@@ -277,6 +277,58 @@ std::optional<LightBounds> PointLight::bounds() const {
     b.cos_theta_e = 0.f;  // isotropic: theta_o = pi already covers every direction
     b.phi = luminance(power());
     return b;
+}
+
+}  // namespace neepp
+
+namespace neepp {
+
+Ray SceneSphere::disk_ray(const Vec3 &d, Vec2 u) const {
+    const Frame frame(d);
+    const Vec2 q = square_to_uniform_disk_concentric(u);
+    // Pushed out by one more radius than the sphere's: a ray starting on the sphere could begin inside
+    // geometry that touches it.
+    const Vec3 o = center + (frame.s * q.x + frame.t * q.y) * radius + d * (2.f * radius);
+    return Ray{o, -d, 0.f, kInfinity};
+}
+
+namespace {
+// An infinite light's emitted ray from its direction sample (ds.d toward the sky, density ds.pdf).
+EmissionSample infinite_emission(const SceneSphere &sphere, const DirectionSample &ds, const Color &radiance, Vec2 u_pos) {
+    EmissionSample es;
+    es.ray = sphere.disk_ray(ds.d, u_pos);
+    es.p = es.ray.o;
+    es.radiance = radiance;
+    es.pdf_pos = sphere.disk_pdf();
+    es.pdf_dir = ds.pdf;
+    return es;
+}
+}  // namespace
+
+EmissionSample EnvironmentMapLight::sample_emission(Vec2 u_pos, Vec2 u_dir) const {
+    Color radiance;
+    const DirectionSample ds = sample_direction(sphere_.center, u_dir, radiance);
+    if (!(ds.pdf > 0)) return {};
+    return infinite_emission(sphere_, ds, radiance, u_pos);
+}
+
+EmissionDensity EnvironmentMapLight::pdf_emission(const Vec3 &, const Vec3 &, const Vec3 &, const Vec3 &w) const {
+    return {sphere_.disk_pdf(), pdf_direction(sphere_.center, direction_sample_from_miss(-w))};
+}
+
+EmissionSample ConstantEnvironmentLight::sample_emission(Vec2 u_pos, Vec2 u_dir) const {
+    Color radiance;
+    return infinite_emission(sphere_, sample_direction(sphere_.center, u_dir, radiance), radiance, u_pos);
+}
+
+EmissionSample PointLight::sample_emission(Vec2, Vec2 u_dir) const {
+    EmissionSample es;
+    es.p = position_;
+    es.ray = Ray{position_, square_to_uniform_sphere(u_dir), 0.f, kInfinity};
+    es.radiance = intensity_;
+    es.pdf_pos = 1.f;
+    es.pdf_dir = kInv4Pi;
+    return es;
 }
 
 }  // namespace neepp

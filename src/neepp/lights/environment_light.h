@@ -10,6 +10,18 @@
 
 namespace neepp {
 
+// The bounding sphere of the scene, which infinite lights emit into (from a disk of its radius).
+struct SceneSphere {
+    Vec3 center{0.f};
+    float radius = 1.f;
+    SceneSphere() = default;
+    explicit SceneSphere(const BBox &b) : center((b.lo + b.hi) * 0.5f), radius(std::max(1e-3f, 0.5f * norm(b.extent()))) {}
+    float disk_pdf() const { return 1.f / (kPi * radius * radius); }
+    // A ray toward -d (d points to the sky) from a point of the disk of the sphere's radius, centred on the
+    // sphere's centre pushed out along d, perpendicular to d.
+    Ray disk_ray(const Vec3 &d, Vec2 u) const;
+};
+
 class EnvironmentMapLight final : public Light {
 public:
     // `image` in linear RGB; `to_world` orients the map (Mitsuba: +y is the map's up, u = 0 faces -z).
@@ -20,9 +32,11 @@ public:
     LightSampleStart begin_sample(Vec2 u) const override;
     DirectionSample finish_sample(const Vec3 &ref, const LightSampleStart &start, Color &radiance) const override;
     Color eval_environment(const Vec3 &d) const override;
+    EmissionSample sample_emission(Vec2 u_pos, Vec2 u_dir) const override;
+    EmissionDensity pdf_emission(const Vec3 &, const Vec3 &, const Vec3 &, const Vec3 &w) const override;
     Color power() const override;
     bool is_infinite() const override { return true; }
-    void prepare(const BBox &b) override { scene_radius_ = std::max(1e-3f, 0.5f * norm(b.extent())); }
+    void prepare(const BBox &b) override { sphere_ = SceneSphere(b); }
 
     // Map between world directions and the map's (u, v) in [0,1)^2 (v = 0 at the top, the +y pole).
     Vec2 direction_to_uv(const Vec3 &d) const;
@@ -63,7 +77,7 @@ private:
     AliasTable cells_;  // sampling cells (texel cells merged down to at most 1024x512), ∝ luminance × sin(theta)
     int sample_w_ = 0, sample_h_ = 0;
     Color mean_radiance_;
-    float scene_radius_ = 1.f;
+    SceneSphere sphere_;
 };
 
 class ConstantEnvironmentLight final : public Light {
@@ -72,13 +86,17 @@ public:
     DirectionSample sample_direction(const Vec3 &ref, Vec2 u, Color &radiance) const override;
     float pdf_direction(const Vec3 &, const DirectionSample &) const override { return kInv4Pi; }
     Color eval_environment(const Vec3 &) const override { return radiance_; }
-    Color power() const override { return radiance_ * (kPi * 4.f * kPi * scene_radius_ * scene_radius_); }
+    EmissionSample sample_emission(Vec2 u_pos, Vec2 u_dir) const override;
+    EmissionDensity pdf_emission(const Vec3 &, const Vec3 &, const Vec3 &, const Vec3 &) const override {
+        return {sphere_.disk_pdf(), kInv4Pi};
+    }
+    Color power() const override { return radiance_ * (kPi * 4.f * kPi * sphere_.radius * sphere_.radius); }
     bool is_infinite() const override { return true; }
-    void prepare(const BBox &b) override { scene_radius_ = std::max(1e-3f, 0.5f * norm(b.extent())); }
+    void prepare(const BBox &b) override { sphere_ = SceneSphere(b); }
 
 private:
     Color radiance_;
-    float scene_radius_ = 1.f;
+    SceneSphere sphere_;
 };
 
 // Mitsuba's `point` light: `intensity` in W/sr at `position`.
@@ -88,6 +106,10 @@ public:
     DirectionSample sample_direction(const Vec3 &ref, Vec2 u, Color &radiance) const override;
     float pdf_direction(const Vec3 &, const DirectionSample &) const override { return 0.f; }
     Color power() const override { return intensity_ * (4.f * kPi); }
+    EmissionSample sample_emission(Vec2 u_pos, Vec2 u_dir) const override;
+    EmissionDensity pdf_emission(const Vec3 &, const Vec3 &, const Vec3 &, const Vec3 &) const override {
+        return {1.f, kInv4Pi};
+    }
     bool is_delta() const override { return true; }
     std::optional<LightBounds> bounds() const override;
     Vec3 position() const { return position_; }

@@ -30,6 +30,27 @@ struct LightSampleStart {
     float density = 0;
 };
 
+// A ray leaving a light, for light paths (light tracing, BDPT): where it starts, which way, how likely.
+// Infinite lights emit from a disk of the scene's bounding sphere's radius, facing the chosen direction and
+// just outside the sphere, so every point of the scene is reached by parallel rays.
+struct EmissionSample {
+    Ray ray;            // its origin moved off the surface, as every ray leaving one
+    Vec3 p;             // the point on the light (an infinite light's: the ray's origin on its disk)
+    Vec3 n;             // geometric normal at the origin (zero for point and infinite lights)
+    Vec3 ns;            // shading normal there (the side that emits)
+    Vec2 uv;
+    Color radiance;     // Le(origin, ray.d); a point light's intensity; an infinite light's radiance along -ray.d
+    float pdf_pos = 0;  // area density of the origin (1 for a point light, 1 / (pi r^2) on an infinite light's disk)
+    float pdf_dir = 0;  // solid-angle density of ray.d
+    bool valid() const { return pdf_pos > 0 && pdf_dir > 0 && !is_black(radiance); }
+};
+
+// The densities with which sample_emission would produce an emitted ray (BDPT's MIS weights need them
+// for rays it did not sample that way).
+struct EmissionDensity {
+    float pos = 0, dir = 0;
+};
+
 class Light {
 public:
     virtual ~Light() = default;
@@ -48,6 +69,12 @@ public:
     }
     // Solid-angle density with which sample_direction would have produced ds from ref (0 for delta lights).
     virtual float pdf_direction(const Vec3 &ref, const DirectionSample &ds) const = 0;
+    // An emitted ray from two pairs of variates, u_pos for the origin and u_dir for the direction.
+    virtual EmissionSample sample_emission(Vec2 u_pos, Vec2 u_dir) const = 0;
+    // The densities of an emitted ray leaving p (geometric normal n, shading normal ns) in direction w. For
+    // infinite lights w is the direction of travel (into the scene) and p, n, ns are not read: the position
+    // density is the disk's.
+    virtual EmissionDensity pdf_emission(const Vec3 &p, const Vec3 &n, const Vec3 &ns, const Vec3 &w) const = 0;
     // Radiance leaving a point of an area light toward direction w (world, pointing away from the light).
     virtual Color eval_surface(const SurfaceInteraction &si, const Vec3 &w) const { return Color(0.f); }
     // Radiance arriving from an infinite light along direction d (world, pointing from the scene to the sky).

@@ -2,6 +2,9 @@
 // splats into the pixels within the reconstruction filter's radius; pixel = Σ w·L / Σ w).
 #pragma once
 #include <algorithm>
+#include <atomic>
+#include <cstdint>
+#include <memory>
 #include <cmath>
 #include <string>
 #include <vector>
@@ -15,6 +18,8 @@ public:
     // type: box, tent, gaussian; radius in pixels (box 0.5, tent 1, gaussian 4·stddev by default)
     ReconstructionFilter(const std::string &type, float radius, float stddev);
     float radius() const { return radius_; }
+    // ∫∫ f(x) f(y) dx dy of the separable 2D filter.
+    float integral() const;
     // 1D profile; the 2D filter is separable. Inline: the film evaluates it for every pixel a sample touches.
     float eval(float x) const {
         x = std::abs(x);
@@ -29,6 +34,36 @@ public:
 private:
     enum class Type { Box, Tent, Gaussian } type_;
     float radius_, inv_radius_, stddev_, gauss_offset_ = 0;
+};
+
+// Contributions that land anywhere on the film, not at the sample's own pixel: light paths connected to
+// the camera (light tracing, BDPT's t = 1 strategies). Each splat is spread over the pixels of the filter's
+// footprint with weights f / ∫f (pbrt's splat normalization: a splat adds its value, not a weighted
+// average), and the image is the sums times a scale the caller knows (pixels / light paths). Sums are
+// fixed point (2^-32 steps, int64) and added atomically: integer addition does not depend on the order,
+// so the image is the same to the bit whichever thread splatted what, and any thread may splat anywhere.
+class SplatFilm {
+public:
+    SplatFilm(int width, int height, const ReconstructionFilter *filter);
+    // Thread-safe. Non-finite values, and values too large for the fixed point, are not added: returns
+    // false for them (the caller counts them as invalid samples).
+    bool add(float px, float py, const Color &L);
+    // Adds another film's sums (same size).
+    void merge(const SplatFilm &other);
+    void clear();
+    // The sums times scale, per pixel.
+    Image resolve(double scale) const;
+    int width() const { return width_; }
+    int height() const { return height_; }
+
+private:
+    static constexpr double kFixedOne = 4294967296.0;  // 2^32
+    // |w·L| per splat beyond this is refused: 2^31 of them still fit an int64 pixel.
+    static constexpr double kMaxValue = 1e9;
+    int width_, height_;
+    const ReconstructionFilter *filter_;
+    float inv_integral_;
+    std::unique_ptr<std::atomic<int64_t>[]> sums_;  // per pixel: r, g, b
 };
 
 // A rectangular block of accumulated samples (a tile plus the filter's border, or the whole image).

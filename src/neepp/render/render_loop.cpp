@@ -85,6 +85,14 @@ RenderResult render(const Scene &scene, Integrator &integrator, const RenderJob 
     ReconstructionFilter filter(scene.settings.rfilter, scene.settings.rfilter_radius, scene.settings.rfilter_stddev);
     const int border = int(std::ceil(filter.radius() - 0.5f));
     ImageBlock accumulated(0, 0, W, H, &filter), pass_block(0, 0, W, H, &filter);
+    // Light tracing and BDPT splat anywhere on the film: a layer of its own, scaled by pixels / light paths.
+    const bool splatting = integrator.splats();
+    std::unique_ptr<SplatFilm> splats_accumulated, splats_pass;
+    if (splatting) {
+        splats_accumulated = std::make_unique<SplatFilm>(W, H, &filter);
+        splats_pass = std::make_unique<SplatFilm>(W, H, &filter);
+    }
+    double light_paths = 0;
     std::mutex merge_mutex;
     std::vector<Tile> tiles = make_tiles(W, H, job.tile_size);
     const std::unique_ptr<Sampler> prototype = make_sampler(job.sampler, job.seed);
@@ -124,7 +132,14 @@ RenderResult render(const Scene &scene, Integrator &integrator, const RenderJob 
         tiles_done = 0;
         pass_size_now = size;
         std::atomic<bool> aborted{false};
+        std::atomic<uint64_t> samples_done{0};  // camera samples of the tiles completed this pass
         const double pass_start = elapsed();
+        uint64_t pass_light_paths = 0;  // traced before the pass (BDPT's NEE++ pool), splatted already
+        if (splatting) {
+            splats_pass->clear();
+            const PassInfo info{result.passes, s0, size, uint64_t(W) * H * size, job.seed};
+            arena.execute([&] { pass_light_paths = integrator.begin_pass(scene, info, *splats_pass, counters.local()); });
+        }
         arena.execute([&] {
             tbb::parallel_for(tbb::blocked_range<size_t>(0, tiles.size(), 1), [&](const tbb::blocked_range<size_t> &r) {
                 const DenormalsAreZero ftz;
@@ -150,21 +165,21 @@ RenderResult render(const Scene &scene, Integrator &integrator, const RenderJob 
                     double m2 = 0;
                     ImageBlock block(t.x0 - border, t.y0 - border, t.w + 2 * border, t.h + 2 * border, &filter);
                     int queued = 0;
+                    auto add = [&](const Vec2 &pos, Color L) {
+                        // Only NaN/inf are dropped: negative values are legitimate for unbiased
+                        // estimators such as NEE++'s control variate and must average out.
+                        if (!is_finite(L)) {
+                            ++c.invalid_samples;
+                            L = Color(0.f);
+                        }
+                        block.put(pos.x, pos.y, L);
+                        m2 += double(luminance(L)) * double(luminance(L));
+                    };
                     auto flush = [&] {
                         integrator.Li_batch(scene, std::span<const Ray>(rays.data(), queued),
                                             std::span<Sampler *const>(samplers.data(), queued),
                                             std::span<Color>(radiance.data(), queued), c);
-                        for (int k = 0; k < queued; ++k) {
-                            Color L = radiance[k];
-                            // Only NaN/inf are dropped: negative values are legitimate for unbiased
-                            // estimators such as NEE++'s control variate and must average out.
-                            if (!is_finite(L)) {
-                                ++c.invalid_samples;
-                                L = Color(0.f);
-                            }
-                            block.put(film_pos[k].x, film_pos[k].y, L);
-                            m2 += double(luminance(L)) * double(luminance(L));
-                        }
+                        for (int k = 0; k < queued; ++k) add(film_pos[k], radiance[k]);
                         queued = 0;
                     };
                     for (int y = t.y0; y < t.y0 + t.h; ++y)
@@ -175,10 +190,15 @@ RenderResult render(const Scene &scene, Integrator &integrator, const RenderJob 
                                 Vec2 jitter = sampler.next_2d();
                                 film_pos[queued] = Vec2(float(x) + jitter.x, float(y) + jitter.y);
                                 rays[queued] = cam.generate_ray({film_pos[queued].x / float(W), film_pos[queued].y / float(H)});
+                                if (splatting) {
+                                    add(film_pos[queued], integrator.Li_splat(scene, rays[queued], sampler, c, *splats_pass));
+                                    continue;
+                                }
                                 if (++queued == kBatch) flush();
                             }
                     if (queued > 0) flush();
                     tile_m2[ti] = m2;
+                    samples_done += uint64_t(t.w) * t.h * size;
                     std::lock_guard<std::mutex> lock(merge_mutex);
                     pass_block.merge(block);
                     ++tiles_done;
@@ -187,11 +207,21 @@ RenderResult render(const Scene &scene, Integrator &integrator, const RenderJob 
         });
         if (aborted) {
             // Keep a partial first pass rather than nothing at all: every pixel it reached is unbiased.
-            if (result.passes == 0) accumulated.merge(pass_block);
+            if (result.passes == 0) {
+                accumulated.merge(pass_block);
+                if (splatting) {
+                    splats_accumulated->merge(*splats_pass);
+                    light_paths += double(pass_light_paths) + integrator.light_paths_per_sample() * double(samples_done);
+                }
+            }
             result.stopped_by = (job.cancel && job.cancel->load()) ? "cancel" : "time";
             break;
         }
         accumulated.merge(pass_block);
+        if (splatting) {
+            splats_accumulated->merge(*splats_pass);
+            light_paths += double(pass_light_paths) + integrator.light_paths_per_sample() * double(samples_done);
+        }
         result.spp += size;
         spp_done_now = result.spp;
         integrator.end_pass(scene, pass_statistics(result.passes, result.spp, size, tile_m2, accumulated));
@@ -206,6 +236,10 @@ RenderResult render(const Scene &scene, Integrator &integrator, const RenderJob 
     for (const RenderCounters &c : counters) result.counters += c;
     result.occlusion_time_s = double(result.counters.occlusion_ticks) * seconds_per_tick();
     result.image = accumulated.resolve();
+    if (splatting && light_paths > 0) {
+        const Image splat = splats_accumulated->resolve(double(W) * H / light_paths);
+        for (size_t i = 0; i < result.image.data.size(); ++i) result.image.data[i] += splat.data[i];
+    }
     return result;
 }
 

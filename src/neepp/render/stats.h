@@ -11,11 +11,15 @@ struct RenderCounters {
     uint64_t shadow_rays_skipped = 0;  // shadow tests answered without tracing (NEE++ rejection)
     uint64_t occlusion_ticks = 0;    // time inside occlusion queries, in CPU timestamp ticks
     uint64_t invalid_samples = 0;    // NaN/inf radiance samples dropped
+    // Light paths (light tracing, BDPT): their closest-hit queries (also counted in rays), and the
+    // contributions splatted onto the film through camera connections.
+    uint64_t light_rays = 0;
+    uint64_t splats = 0;
 
     RenderCounters &operator+=(const RenderCounters &o) {
         rays += o.rays; shadow_rays += o.shadow_rays; shadow_rays_occluded += o.shadow_rays_occluded;
         shadow_rays_skipped += o.shadow_rays_skipped; occlusion_ticks += o.occlusion_ticks;
-        invalid_samples += o.invalid_samples;
+        invalid_samples += o.invalid_samples; light_rays += o.light_rays; splats += o.splats;
         return *this;
     }
 };

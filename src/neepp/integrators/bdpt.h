@@ -1,0 +1,94 @@
+// Bidirectional path tracing (Veach & Guibas 1995; Veach's thesis ch. 10) and light tracing, with the
+// path integrator's Mitsuba semantics for max_depth (edges of the whole path: 1 = emitters seen
+// directly), rr_depth and hide_emitters. Every connection's shadow ray goes through the shadow-ray
+// component, so NEE++'s policies apply to BDPT as they do to NEE.
+//
+// A camera subpath x0..x(t-1) and a light subpath y0..y(s-1) are joined by every strategy (s, t): s = 0
+// is the camera path finding an emitter, s = 1 a light point sampled from x(t-1) (next event
+// estimation), t = 1 a light-path vertex connected to the camera and splatted onto the film, the rest a
+// connection between y(s-1) and x(t-1). The strategies are combined by MIS (power or balance heuristic)
+// from the densities each vertex keeps (path_vertex.h).
+//
+// NEE++ light-subpath selection (shared/design/NEEPP.md §4, light_paths=neepp): before each pass a pool
+// of M light subpaths is traced, and their t = 1 strategies are splatted (the film's splats are scaled
+// by pixels / light paths, so M paths estimate the same as one per camera sample). Each camera subpath
+// then draws K candidates uniformly from the pool, scores each by the visibility map between its
+// vertices' voxels and the candidate's (times both throughputs' luminance), chooses one with probability
+// p_i ∝ score mixed with 10 % uniform, and weights its s >= 2, t >= 2 connections by 1 / (K p_i): in
+// expectation the connection with a light path drawn from the pool, hence with a light subpath, so every
+// strategy keeps its MIS weight. K = 1 is plain BDPT over a shared pool.
+#pragma once
+#include <memory>
+#include <string>
+#include <vector>
+#include "neepp/integrators/integrator.h"
+#include "neepp/integrators/path_vertex.h"
+#include "neepp/visibility/shadow_ray_tester.h"
+
+namespace neepp {
+
+struct BDPTOptions {
+    int max_depth = -1;
+    int rr_depth = 5;
+    bool hide_emitters = false;
+    // `light` (particle tracing): light paths only, every vertex connected to the camera, unweighted.
+    bool light_tracer = false;
+    int strategy_s = -1, strategy_t = -1;  // one (s, t) strategy only (both >= 0), else all
+    bool strategy_mis = true;              // that strategy MIS-weighted (as in the full image) or not
+    bool power_heuristic = true;           // mis=power, else balance
+    bool neepp_selection = false;          // light_paths=neepp
+    int candidates = 8;                    // K
+    int pool = 4096;                       // M
+    int voxels = 16;
+};
+
+class BDPTIntegrator final : public Integrator {
+public:
+    BDPTIntegrator(BDPTOptions options, std::unique_ptr<ShadowRayTester> shadow);
+    void prepare(const Scene &scene) override;
+    Color Li(const Scene &scene, const Ray &ray, Sampler &sampler, RenderCounters &counters) const override;
+    bool splats() const override { return true; }
+    Color Li_splat(const Scene &scene, const Ray &ray, Sampler &sampler, RenderCounters &counters,
+                   SplatFilm &splats) const override;
+    double light_paths_per_sample() const override { return options_.neepp_selection ? 0.0 : 1.0; }
+    uint64_t begin_pass(const Scene &scene, const PassInfo &pass, SplatFilm &splats, RenderCounters &counters) override;
+    void end_pass(const Scene &scene, const PassStatistics &pass) override;
+    bool learns_between_passes() const override { return shadow_->learns_between_passes(); }
+    nlohmann::json describe() const override;
+    nlohmann::json statistics() const override;
+    const BDPTOptions &options() const { return options_; }
+
+    // The densities a strategy would have produced its path with, combined: the MIS weight of strategy
+    // (s, t) for the path light[0..s) + camera[0..t) reversed, `sampled` standing in for light[0] (s = 1)
+    // or camera[0] (t = 1). Public for tests (the weights of a path's strategies sum to one).
+    float mis_weight(const std::vector<PathVertex> &light, const std::vector<PathVertex> &camera,
+                     const PathVertex &sampled, int s, int t) const;
+    const BidirContext &context() const { return ctx_; }
+    ShadowRayTester &shadow_rays() { return *shadow_; }
+
+private:
+    // Contribution of strategy (s, t), MIS weight and visibility included; raster receives where a t = 1
+    // strategy lands on the film.
+    Color connect(const std::vector<PathVertex> &light, const std::vector<PathVertex> &camera, int s, int t,
+                  Sampler &sampler, RenderCounters &counters, Vec2 &raster) const;
+    bool wants(int s, int t) const;  // whether this render uses strategy (s, t)
+    // Splats the t = 1 strategies of a light subpath (scaled by `scale`).
+    void splat_light_path(const std::vector<PathVertex> &light, Sampler &sampler, RenderCounters &counters,
+                          SplatFilm &splats, float scale) const;
+    // NEE++: the pool path the camera subpath connects to, and its weight 1 / (K p); null if none.
+    const std::vector<PathVertex> *choose_light_path(const std::vector<PathVertex> &camera, Sampler &sampler,
+                                                     float &weight) const;
+
+    BDPTOptions options_;
+    WalkOptions camera_walk_, light_walk_;
+    std::unique_ptr<ShadowRayTester> shadow_;
+    const ShadowRayTester *queries_ = nullptr;
+    std::unique_ptr<LightSampler> light_sampler_;
+    BidirContext ctx_;
+    // NEE++ pool of the coming pass: light subpaths and their vertices' voxels.
+    std::vector<std::vector<PathVertex>> pool_;
+    std::vector<std::vector<uint32_t>> pool_cells_;
+    uint64_t pool_paths_traced_ = 0;
+};
+
+}  // namespace neepp

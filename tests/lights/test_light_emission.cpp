@@ -1,0 +1,138 @@
+// Emission sampling (light paths of BDPT and light tracing): each light's emitted rays follow the densities
+// pdf_emission reports for them (chi-square over directions, and the round trip on every sample), and
+// carry the light's flux (E[Le |cos| / (pdf_pos pdf_dir)] is the emitted power).
+#include <gtest/gtest.h>
+#include "common/chi2.h"
+#include "neepp/lights/area_light.h"
+#include "neepp/lights/environment_light.h"
+#include "neepp/materials/texture.h"
+#include "neepp/sampling/rng.h"
+
+using namespace neepp;
+using namespace neepp::test;
+
+namespace {
+
+Shape make_sphere(bool flip) {
+    Shape s;
+    s.kind = Shape::Kind::Sphere;
+    s.center = Vec3(0.3f, -0.2f, 1.f);
+    s.radius = 0.7f;
+    s.flip_normals = flip;
+    s.finalize();
+    return s;
+}
+
+Image make_sky() {
+    Image img(16, 8, 3);
+    for (int y = 0; y < 8; ++y)
+        for (int x = 0; x < 16; ++x)
+            for (int c = 0; c < 3; ++c) img.at(x, y, c) = (x == 3 && y == 2) ? 30.f : 0.2f + 0.05f * float(x % 5 + c);
+    return img;
+}
+
+void expect_round_trip(const Light &light, int n = 20000) {
+    PCG32 rng(7, 11);
+    int valid = 0;
+    for (int i = 0; i < n; ++i) {
+        const EmissionSample es = light.sample_emission(rng.next_2d(), rng.next_2d());
+        if (!es.valid()) continue;
+        ++valid;
+        const EmissionDensity d = light.pdf_emission(es.p, es.n, es.ns, es.ray.d);
+        ASSERT_NEAR(d.pos, es.pdf_pos, 1e-5f * es.pdf_pos);
+        ASSERT_NEAR(d.dir, es.pdf_dir, 2e-3f * es.pdf_dir);
+        ASSERT_NEAR(norm(es.ray.d), 1.f, 1e-5f);
+    }
+    EXPECT_GT(valid, n * 9 / 10);
+}
+
+// Directions emitted from one fixed origin (u_pos held), against pdf_emission's direction density there.
+Chi2Result chi2_directions(const Light &light, Vec2 u_pos) {
+    const EmissionSample at = light.sample_emission(u_pos, Vec2(0.5f, 0.5f));
+    SphereChi2Config cfg;
+    cfg.res = 40;
+    cfg.ires = 8;
+    cfg.sample_count = 300000;
+    return chi2_sphere_test(
+        [&](PCG32 &rng) -> std::optional<Vec3> {
+            const EmissionSample es = light.sample_emission(u_pos, rng.next_2d());
+            if (!es.valid()) return std::nullopt;
+            return es.ray.d;
+        },
+        [&](const Vec3 &w) { return double(light.pdf_emission(at.p, at.n, at.ns, w).dir); }, cfg);
+}
+
+// E[Le |cos theta| / (pdf_pos pdf_dir)] over emitted rays: the light's flux.
+double mean_flux(const Light &light, int n = 400000) {
+    PCG32 rng(3, 5);
+    double sum = 0;
+    for (int i = 0; i < n; ++i) {
+        const EmissionSample es = light.sample_emission(rng.next_2d(), rng.next_2d());
+        if (!es.valid()) continue;
+        const float cos = (es.n.x == 0 && es.n.y == 0 && es.n.z == 0) ? 1.f : std::abs(dot(es.n, es.ray.d));
+        sum += luminance(es.radiance) * cos / (es.pdf_pos * es.pdf_dir);
+    }
+    return sum / n;
+}
+
+TEST(LightEmission, AreaLightRaysFollowTheirDensities) {
+    for (bool flip : {false, true}) {
+        Shape shape = make_sphere(flip);
+        AreaLight light(&shape, constant_texture(Color(2.f, 1.f, 0.5f)));
+        light.prepare(shape.bounds());
+        expect_round_trip(light);
+        for (Vec2 u : {Vec2(0.2f, 0.7f), Vec2(0.9f, 0.1f)}) {
+            const Chi2Result r = chi2_directions(light, u);
+            ASSERT_TRUE(r.error.empty()) << r.describe();
+            EXPECT_GT(r.p_value, 1e-4) << r.describe();
+            EXPECT_NEAR(r.pdf_integral, 1.0, 2e-3) << r.describe();
+        }
+        // The power a light sampler weighs it by: pi · area · Le.
+        EXPECT_NEAR(mean_flux(light), luminance(light.power()), 1e-2 * luminance(light.power()));
+        // Emitted from the side that emits: outward unless the normals are flipped.
+        PCG32 rng(1, 2);
+        for (int i = 0; i < 200; ++i) {
+            const EmissionSample es = light.sample_emission(rng.next_2d(), rng.next_2d());
+            EXPECT_EQ(dot(es.ray.d, es.p - shape.center) > 0, !flip);
+        }
+    }
+}
+
+TEST(LightEmission, EnvironmentRaysComeFromADiskAcrossTheScene) {
+    const BBox bounds{Vec3(-1.f, 0.f, -2.f), Vec3(3.f, 1.f, 0.f)};
+    const SceneSphere sphere(bounds);
+    EnvironmentMapLight env(make_sky(), Transform::rotate(Vec3(0.f, 1.f, 0.3f), 25.f), 1.5f);
+    ConstantEnvironmentLight constant(Color(0.5f));
+    for (Light *light : {static_cast<Light *>(&env), static_cast<Light *>(&constant)}) {
+        light->prepare(bounds);
+        expect_round_trip(*light);
+        const Chi2Result r = chi2_directions(*light, Vec2(0.3f, 0.6f));
+        ASSERT_TRUE(r.error.empty()) << r.describe();
+        EXPECT_GT(r.p_value, 1e-4) << r.describe();
+        // Every ray starts outside the bounding sphere, aimed so it crosses the disk through the centre
+        // perpendicular to it at most a radius from the centre: the whole scene is reached.
+        PCG32 rng(5, 6);
+        for (int i = 0; i < 500; ++i) {
+            const EmissionSample es = light->sample_emission(rng.next_2d(), rng.next_2d());
+            ASSERT_GT(norm(es.ray.o - sphere.center), sphere.radius);
+            const Vec3 to_center = sphere.center - es.ray.o;
+            const Vec3 across = to_center - es.ray.d * dot(to_center, es.ray.d);
+            EXPECT_LE(norm(across), sphere.radius * (1 + 1e-4f));
+            EXPECT_GT(dot(to_center, es.ray.d), 0.f);
+        }
+    }
+    // A constant environment's flux through the disk: L · 4 pi · pi r².
+    EXPECT_NEAR(mean_flux(constant), 0.5 * 4 * kPi * kPi * sphere.radius * sphere.radius,
+                1e-3 * 0.5 * 4 * kPi * kPi * sphere.radius * sphere.radius);
+}
+
+TEST(LightEmission, PointLightEmitsItsIntensityEverywhere) {
+    PointLight light(Vec3(1.f, 2.f, 3.f), Color(4.f));
+    expect_round_trip(light);
+    const Chi2Result r = chi2_directions(light, Vec2(0.5f, 0.5f));
+    ASSERT_TRUE(r.error.empty()) << r.describe();
+    EXPECT_GT(r.p_value, 1e-4) << r.describe();
+    EXPECT_NEAR(mean_flux(light), luminance(light.power()), 1e-4 * luminance(light.power()));
+}
+
+}  // namespace
