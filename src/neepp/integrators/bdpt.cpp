@@ -111,7 +111,10 @@ bool BDPTIntegrator::wants(int s, int t) const {
 float BDPTIntegrator::mis_weight(const std::vector<PathVertex> &light, const std::vector<PathVertex> &camera,
                                  const PathVertex &sampled, int s, int t) const {
     if (s + t == 2) return 1.f;
-    const PathVertex *lv[kMaxUnboundedVertices + 2] = {}, *cv[kMaxUnboundedVertices + 2] = {};
+    // Not zero-filled: only the first s and t entries are read (filling the arrays was a fifth of the
+    // function's time).
+    const PathVertex *lv[kMaxUnboundedVertices + 2], *cv[kMaxUnboundedVertices + 2];
+    cv[0] = &sampled;  // t >= 1 always; tells the compiler cv[t - 1] is written
     float lfwd[kMaxUnboundedVertices + 2], lrev[kMaxUnboundedVertices + 2];
     float cfwd[kMaxUnboundedVertices + 2], crev[kMaxUnboundedVertices + 2];
     bool ldelta[kMaxUnboundedVertices + 2], cdelta[kMaxUnboundedVertices + 2];
@@ -154,7 +157,9 @@ Color BDPTIntegrator::connect(const std::vector<PathVertex> &light, const std::v
                               int t, Sampler &sampler, RenderCounters &counters, Vec2 &raster) const {
     const PathVertex &pt = camera[t - 1];
     if (t > 1 && s != 0 && pt.infinite) return Color(0.f);
-    PathVertex sampled;
+    // The vertex a strategy samples afresh (the camera for t = 1, a light point for s = 1): a slot kept
+    // per thread, since a vertex is large and most strategies need none.
+    thread_local PathVertex sampled;
     Color L(0.f);
     bool test = true;            // a shadow ray decides
     const PathVertex *from = &pt, *to = nullptr;  // its ends: camera side, light side
@@ -167,6 +172,7 @@ Color BDPTIntegrator::connect(const std::vector<PathVertex> &light, const std::v
         if (!qs.connectible()) return Color(0.f);
         const CameraConnection c = ctx_.camera->connect(qs.p);
         if (!c.valid()) return Color(0.f);
+        sampled = PathVertex{};
         sampled.kind = VertexKind::Camera;
         sampled.p = ctx_.camera->position();
         L = qs.beta * scatter(qs, c.d) * c.weight;
@@ -181,6 +187,7 @@ Color BDPTIntegrator::connect(const std::vector<PathVertex> &light, const std::v
         Color Le;
         const DirectionSample ds = sl.light->sample_direction(pt.p, u, Le);
         if (!(ds.pdf > 0) || is_black(Le)) return Color(0.f);
+        sampled = PathVertex{};
         sampled.kind = VertexKind::Light;
         sampled.mode = TransportMode::Importance;
         sampled.light = sl.light;
