@@ -216,9 +216,10 @@ void light_subpath(const BidirContext &ctx, const WalkOptions &options, Sampler 
         v.si.uv = es.uv;
         if (v.on_surface()) cos_emit = std::abs(dot(es.n, es.ray.d));
     }
+    // The density of starting here: light choice times position, or for the sky, its direction density
+    // summed over the infinite lights (the `next` argument is not read for them).
+    v.pdf_fwd = v.infinite ? pdf_light_origin(ctx, v, v) : sl.pmf * es.pdf_pos;
     path.push_back(v);
-    path.back().pdf_fwd = pdf_light_origin(ctx, path.back(), path.back());
-    if (!sl.light->is_infinite()) path.back().pdf_fwd = sl.pmf * es.pdf_pos;
     random_walk(ctx, es.ray, v.beta * (cos_emit / es.pdf_dir), es.pdf_dir, TransportMode::Importance, options, sampler,
                 path, counters);
 }
