@@ -3,13 +3,13 @@
 #include <chrono>
 #include <csignal>
 #include <filesystem>
-#include <fstream>
 #include <iostream>
 #include <stdexcept>
 #include <unistd.h>
 #include <CLI/CLI.hpp>
 #include <fmt/core.h>
 #include "neepp/integrators/integrator.h"
+#include "neepp/io/atomic_file.h"
 #include "neepp/light_selection/factory.h"
 #include "neepp/loader/scene_loader.h"
 #include "neepp/render/huge_pages.h"
@@ -22,11 +22,15 @@
 namespace {
 
 std::atomic<bool> g_cancel{false};
+std::atomic<int> g_signal{0};
 
-extern "C" void on_sigint(int) {
-    // First Ctrl-C: stop after the current tile and write what we have. Second: the default action.
+extern "C" void on_stop_signal(int sig) {
+    // First Ctrl-C or SIGTERM (a batch system's stop, `kill`): stop after the current tile and write what
+    // we have. A second: the default action.
+    g_signal = sig;
     g_cancel = true;
     std::signal(SIGINT, SIG_DFL);
+    std::signal(SIGTERM, SIG_DFL);
 }
 
 std::pair<std::string, std::string> split_key_value(const std::string &s, const char *what) {
@@ -74,6 +78,7 @@ struct Rendered {
 Rendered run_render(const RenderArgs &a) {
     check_output_path(a.output, "output image", ".exr");
     if (!a.stats.empty()) check_output_path(a.stats, "statistics file", nullptr);
+    if (!a.visibility_map.empty()) check_output_path(a.visibility_map, "visibility map", nullptr);
     std::map<std::string, std::string> defines;
     for (auto &d : a.defines) defines.insert(split_key_value(d, "-D"));
     if (a.spp > 0 && !defines.count("spp")) defines["spp"] = std::to_string(a.spp);
@@ -113,11 +118,7 @@ Rendered run_render(const RenderArgs &a) {
     std::string png = neepp::write_render_images(a.output, result.image);
     nlohmann::json stats = neepp::render_statistics(*scene, *integrator, result, job);
     stats["load_time_s"] = load_s;
-    if (!a.stats.empty()) {
-        std::ofstream out(a.stats);
-        out << stats.dump(2) << "\n";
-        if (!out) throw std::runtime_error(fmt::format("could not write the statistics file '{}'", a.stats));
-    }
+    if (!a.stats.empty()) neepp::write_file_atomically(a.stats, stats.dump(2) + "\n");
     if (!a.quiet)
         fmt::print(stderr, "neepp: {} spp in {:.2f} s ({:.3f} M samples/s, stopped by {}), wrote {} and {}\n", result.spp,
                    result.render_time_s, stats["samples_per_s"].get<double>() * 1e-6, result.stopped_by, a.output, png);
@@ -202,7 +203,7 @@ void run_demo(const std::string &dir, int spp, bool quiet) {
                                     {"light_paths=neepp"}, "demo_bdpt_side_by_side.png", "bdpt");
     nlohmann::json summary = {{"shadow_ray_rejection", rejection}, {"light_selection", selection},
                               {"bdpt_light_path_selection", bdpt}};
-    std::ofstream(dir + "/demo_summary.json") << summary.dump(2) << "\n";
+    neepp::write_file_atomically(dir + "/demo_summary.json", summary.dump(2) + "\n");
     if (!quiet) {
         fmt::print(stderr,
                    "neepp demo: in {:.2f} s, NEE reached {} spp and NEE++ {} spp ({:.2f}x), with {:.2f}x the shadow rays per "
@@ -266,7 +267,8 @@ int main(int argc, char **argv) {
     demo->add_flag("-q,--quiet", demo_quiet, "No progress bar or messages");
 
     CLI11_PARSE(app, argc, argv);
-    std::signal(SIGINT, on_sigint);
+    std::signal(SIGINT, on_stop_signal);
+    std::signal(SIGTERM, on_stop_signal);
     try {
         if (*render) {
             run_render(ra);
@@ -277,5 +279,5 @@ int main(int argc, char **argv) {
         fmt::print(stderr, "neepp: error: {}\n", e.what());
         return 1;
     }
-    return g_cancel ? 130 : 0;
+    return g_cancel ? 128 + g_signal.load() : 0;  // the shell's convention: 130 after Ctrl-C, 143 after SIGTERM
 }

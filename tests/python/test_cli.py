@@ -3,6 +3,7 @@ from __future__ import annotations
 
 import json
 import os
+import random
 import signal
 import subprocess
 import time
@@ -106,14 +107,15 @@ def test_time_limit_writes_the_image_reached(neepp_bin, tmp_path):
     assert (tmp_path / "t.png").exists()
 
 
-def test_ctrl_c_stops_cleanly_and_writes_the_image(neepp_bin, tmp_path):
+@pytest.mark.parametrize("sig, code", [(signal.SIGINT, 130), (signal.SIGTERM, 143)])
+def test_ctrl_c_and_sigterm_stop_cleanly_and_write_the_image(neepp_bin, tmp_path, sig, code):
     p = subprocess.Popen([str(neepp_bin), "render", str(DEMO), "-o", str(tmp_path / "c.exr"), "--spp", "100000",
                           "--stats", str(tmp_path / "s.json"), "--quiet", "-D", "resx=160", "-D", "resy=90"],
                          stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
     time.sleep(2.0)
-    p.send_signal(signal.SIGINT)
+    p.send_signal(sig)
     _, err = p.communicate(timeout=60)
-    assert p.returncode == 130, err
+    assert p.returncode == code, err
     s = json.loads((tmp_path / "s.json").read_text())
     assert s["stopped_by"] == "cancel" and 1 <= s["spp"] < 100000
     assert (tmp_path / "c.exr").stat().st_size > 0
@@ -174,6 +176,63 @@ def test_unwritable_output_is_refused_before_rendering(neepp_bin, tmp_path, outp
     r = run(neepp_bin, *args, timeout=30)
     assert r.returncode == 1, (r.returncode, r.stderr)
     assert expect in r.stderr, r.stderr
+
+
+def test_read_only_output_folder_is_refused_before_rendering(neepp_bin, tmp_path):
+    if os.geteuid() == 0:
+        pytest.skip("root may write into a read-only folder, so there is nothing to refuse")
+    folder = tmp_path / "ro"
+    folder.mkdir()
+    folder.chmod(0o500)
+    try:
+        r = run(neepp_bin, "render", DEMO, "-o", folder / "a.exr", "--spp", 1000000, "--quiet", timeout=30)
+    finally:
+        folder.chmod(0o700)
+    assert r.returncode == 1 and "is not writable" in r.stderr, (r.returncode, r.stderr)
+
+
+def test_unwritable_visibility_map_is_refused_before_rendering(neepp_bin, tmp_path):
+    (tmp_path / "blocker").write_text("a file where a folder is asked for")
+    r = run(neepp_bin, "render", DEMO, "-o", tmp_path / "a.exr", "--spp", 1000000, "--quiet", "-I",
+            "shadow_rays=neepp", "--visibility-map", tmp_path / "blocker" / "map.bin", timeout=30)
+    assert r.returncode == 1 and "cannot create the folder" in r.stderr, (r.returncode, r.stderr)
+
+
+def test_a_render_killed_at_any_moment_leaves_no_damaged_file(neepp_bin, tmp_path):
+    # The same render (seed, threads) over and over, each killed (SIGKILL: no handler runs) at a random
+    # moment of its life, loading, rendering or writing: under each output's name there must always be
+    # either nothing (before the first complete run) or a whole file, the same bytes as a complete run's.
+    # A big film makes writing the EXR and PNG (~40 % of a run) a target the kills often hit.
+    out, stats = tmp_path / "k.exr", tmp_path / "k.json"
+    args = [str(neepp_bin), "render", str(DEMO), "-o", str(out), "--spp", "1", "--threads", "2", "--stats",
+            str(stats), "--quiet", "-D", "resx=1280", "-D", "resy=720"]
+    t0 = time.time()
+    subprocess.run(args, check=True, capture_output=True, timeout=120)
+    full_run_s = time.time() - t0
+    ref_exr, ref_png = out.read_bytes(), out.with_suffix(".png").read_bytes()
+    for f in (out, out.with_suffix(".png"), stats):
+        f.unlink()
+    rng = random.Random(29)
+    completed = killed = 0
+    for attempt in range(40):
+        p = subprocess.Popen(args, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+        try:
+            p.wait(timeout=rng.uniform(0.0, 1.1 * full_run_s))
+        except subprocess.TimeoutExpired:
+            p.kill()
+            p.wait(timeout=60)
+        if p.returncode == 0:
+            completed += 1
+        else:
+            killed += 1
+        for f, ref in ((out, ref_exr), (out.with_suffix(".png"), ref_png)):
+            if f.exists():
+                assert f.read_bytes() == ref, f"attempt {attempt}: {f.name} is damaged ({f.stat().st_size} bytes)"
+            else:
+                assert completed == 0, f"attempt {attempt}: {f.name} vanished after a complete run"
+        if stats.exists():
+            assert json.loads(stats.read_text())["spp"] == 1, f"attempt {attempt}: the statistics are damaged"
+    assert killed >= 10 and completed >= 1, (killed, completed)  # the kills did land, and runs did finish
 
 
 def test_pgo_training_run_renders(neepp_bin, tmp_path):

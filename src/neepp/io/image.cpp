@@ -22,6 +22,7 @@
 #include <memory>
 #include <stdexcept>
 #include <thread>
+#include "neepp/io/atomic_file.h"
 
 namespace neepp {
 
@@ -252,9 +253,11 @@ void write_exr(const std::string &path, const Image &img, bool half) {
             header.channels().insert(names[c], Imf::Channel(type));
             fb.insert(names[c], Imf::Slice(type, base + c * elem, xstride, ystride));
         }
-        Imf::OutputFile file(path.c_str(), header);
-        file.setFrameBuffer(fb);
-        file.writePixels(img.height);
+        write_file_atomically(path, [&](const std::string &tmp) {
+            Imf::OutputFile file(tmp.c_str(), header);
+            file.setFrameBuffer(fb);
+            file.writePixels(img.height);
+        });
     } catch (const std::exception &e) {
         fail(path, fmt::format("cannot write OpenEXR file: {}", e.what()));
     }
@@ -271,8 +274,10 @@ void write_png_srgb(const std::string &path, const Image &img, float exposure) {
         if (!alpha) v = linear_to_srgb(v);
         bytes[i] = (unsigned char)(v * 255.f + 0.5f);
     }
-    if (!stbi_write_png(path.c_str(), img.width, img.height, img.channels, bytes.data(), img.width * img.channels))
-        fail(path, "cannot write PNG file");
+    write_file_atomically(path, [&](const std::string &tmp) {
+        if (!stbi_write_png(tmp.c_str(), img.width, img.height, img.channels, bytes.data(), img.width * img.channels))
+            fail(path, "cannot write PNG file");
+    });
 }
 
 float srgb_to_linear(float v) {

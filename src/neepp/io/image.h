@@ -45,6 +45,7 @@ struct ImageBytes {
 std::optional<ImageBytes> read_image_bytes(const std::string &path);
 
 // Writes the image to OpenEXR (half or float; channels named Y, YA, RGB or RGBA). Throws on failure.
+// Both writers replace the file atomically (see atomic_file.h): never a half-written image.
 void write_exr(const std::string &path, const Image &img, bool half = false);
 // Writes an 8-bit sRGB PNG after exposure scaling and clamping (no other tonemapping). Alpha, if
 // present, is written linearly and unscaled. Throws on failure.

@@ -5,6 +5,7 @@
 #include <iterator>
 #include <stdexcept>
 #include <fmt/format.h>
+#include "neepp/io/atomic_file.h"
 #include "neepp/scene/scene.h"
 
 namespace neepp {
@@ -89,15 +90,11 @@ void save_visibility_map(const std::string &path, const VoxelGrid &grid, const V
             w.put(data[i].traced);
         }
     w.put(fnv1a64(w.bytes.data(), w.bytes.size()));
-    // Write beside the target and rename, so an interrupted save never leaves a half file under the name.
-    std::string tmp = path + ".tmp";
-    {
-        std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
-        out.write(w.bytes.data(), std::streamsize(w.bytes.size()));
-        if (!out) throw std::runtime_error(fmt::format("visibility map '{}': cannot write", path));
+    try {
+        write_file_atomically(path, w.bytes);
+    } catch (const std::exception &e) {
+        throw std::runtime_error(fmt::format("visibility map {}", e.what()));
     }
-    if (std::rename(tmp.c_str(), path.c_str()) != 0)
-        throw std::runtime_error(fmt::format("visibility map '{}': cannot rename {} to it", path, tmp));
 }
 
 VisibilityMap load_visibility_map(const std::string &path, const VoxelGrid &grid, uint64_t fingerprint) {

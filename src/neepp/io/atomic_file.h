@@ -1,0 +1,18 @@
+// Files that are never seen half-written: a render killed at any moment (SIGKILL, power loss, a full
+// disk) leaves under an output's name either the previous complete file or the new complete one.
+#pragma once
+#include <functional>
+#include <string>
+
+namespace neepp {
+
+// Calls write(temporary) to write the whole file to a temporary path in the target's folder (the same
+// file system, so the rename is atomic), flushes it to disk, then renames it over path. On any failure
+// the temporary file is removed and the target left as it was; write's exceptions propagate, and a
+// failed flush or rename throws std::runtime_error naming path.
+void write_file_atomically(const std::string &path, const std::function<void(const std::string &temporary)> &write);
+
+// The same for a file whose whole content is in memory (statistics JSON, visibility maps).
+void write_file_atomically(const std::string &path, const std::string &content);
+
+}  // namespace neepp
