@@ -1,4 +1,5 @@
 #include <cmath>
+#include <fmt/core.h>
 #include "neepp/io/obj_reader.h"
 #include "neepp/io/ply_reader.h"
 #include "neepp/lights/area_light.h"
@@ -84,6 +85,18 @@ void set_mesh(Shape &s, MeshData mesh, const Transform &to_world) {
     if (!s.face_normals && s.normals.empty()) compute_vertex_normals(s);
 }
 
+// Whether the shape has a surface: a mesh with no triangles, or only degenerate ones (a scale of 0,
+// collinear vertices), has none, and an emitter on it would be a light of zero area, which neither
+// light sampling nor emission sampling can sample a point of.
+bool has_surface(const Shape &s) {
+    if (s.kind == Shape::Kind::Sphere) return true;
+    for (size_t t = 0; t + 2 < s.indices.size(); t += 3) {
+        const Vec3 &a = s.positions[s.indices[t]];
+        if (norm(cross(s.positions[s.indices[t + 1]] - a, s.positions[s.indices[t + 2]] - a)) > 0) return true;
+    }
+    return false;
+}
+
 }  // namespace
 
 void Factories::shape(const XmlNode &node, Scene &scene) {
@@ -142,6 +155,11 @@ void Factories::shape(const XmlNode &node, Scene &scene) {
         if (emitter_node->type != "area") throw emitter_node->error("a shape can only carry an 'area' emitter");
         TexturePtr radiance = texture_param(*emitter_node, "radiance", Color(1.f));
         warn_unused(*emitter_node);
+        if (!has_surface(*shape)) {
+            fmt::print(stderr, "neepp: warning: {}:{}: the {} shape has no surface (no triangle of non-zero area): its "
+                               "area emitter is left out\n", node.file, node.line, node.type);
+            return;
+        }
         shape->area_light = scene.add_light(std::make_unique<AreaLight>(shape, radiance));
     }
 }

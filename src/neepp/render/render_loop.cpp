@@ -11,6 +11,7 @@
 #include "neepp/integrators/integrator.h"
 #include "neepp/math/denormals.h"
 #include "neepp/render/film.h"
+#include "neepp/render/memory.h"
 #include "neepp/render/progress_bar.h"
 #include "neepp/sampling/sampler.h"
 #include "neepp/scene/scene.h"
@@ -82,11 +83,15 @@ RenderResult render(const Scene &scene, Integrator &integrator, const RenderJob 
     const bool timed = job.time_limit_s > 0;
     if (job.spp <= 0 && !timed) throw std::invalid_argument("render: give a sample count or a time limit");
 
+    // Per pixel: the image and the pass (ImageBlock, 32 bytes each), the image resolved for the pass
+    // statistics and for the result (12 each), the PNG's bytes (4); with splats, two splat films (24
+    // bytes each) and the splat layer resolved (12).
+    const bool splatting = integrator.splats();
+    check_film_fits_in_memory(W, H, 2 * 32 + 2 * 12 + 4 + (splatting ? 2 * 24 + 12 : 0));
     ReconstructionFilter filter(scene.settings.rfilter, scene.settings.rfilter_radius, scene.settings.rfilter_stddev);
     const int border = int(std::ceil(filter.radius() - 0.5f));
     ImageBlock accumulated(0, 0, W, H, &filter), pass_block(0, 0, W, H, &filter);
     // Light tracing and BDPT splat anywhere on the film: a layer of its own, scaled by pixels / light paths.
-    const bool splatting = integrator.splats();
     std::unique_ptr<SplatFilm> splats_accumulated, splats_pass;
     if (splatting) {
         splats_accumulated = std::make_unique<SplatFilm>(W, H, &filter);
