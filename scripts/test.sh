@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # The whole test suite: installs what it needs (Debian packages, the Python venv with Mitsuba 3),
-# builds, then runs the C++ tests (ctest) and the Python tests (pytest: CLI, comparison with Mitsuba 3).
+# builds, then runs the C++ tests (ctest, then again under sanitizers), the fuzz targets for 30 s each,
+# and the Python tests (pytest: CLI, comparison with Mitsuba 3).
 set -euo pipefail
 ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 # valgrind: tests/python/test_instructions.py runs bench/instructions.py, which counts instructions with it.
@@ -11,4 +12,8 @@ ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 # AVX-512 CPU: it gets a build for x86-64-v3, on every CPU alike.
 "$ROOT/scripts/build_valgrind.sh"
 ctest --test-dir "$ROOT/build" --output-on-failure -j2
+# The C++ tests again under AddressSanitizer + UndefinedBehaviorSanitizer (clang), then each fuzz target
+# of fuzz/ for 30 s: both in build-sanitize/.
+"$ROOT/scripts/test_sanitizers.sh"
+"$ROOT/scripts/fuzz.sh" 30
 cd "$ROOT" && NEEPP_BIN="$ROOT/build/neepp" "$ROOT/.venv/bin/python" -m pytest tests/python -q -rs

@@ -48,7 +48,7 @@ Stream read_stream(const std::string &path) {
         if ((h.query != Query::Intersect && h.query != Query::Occluded) || h.coherent > 1 || h.rays > 16)
             throw std::runtime_error(path + ": not a ray record file (bad call header)");
         s.calls.push_back({h.query, h.coherent != 0, int(s.rays.size()), int(h.rays)});
-        for (int i = 0; i < h.rays; ++i) {
+        for (uint32_t i = 0; i < h.rays; ++i) {
             RayRecord r;
             if (!in.read(reinterpret_cast<char *>(&r), sizeof r)) throw std::runtime_error(path + ": truncated");
             s.rays.push_back(Ray{Vec3(r.org[0], r.org[1], r.org[2]), Vec3(r.dir[0], r.dir[1], r.dir[2]), r.tnear, r.tfar});

@@ -16,8 +16,7 @@ namespace {
 // Hidden, and named for this process so two renders writing the same output never share one.
 std::string temporary_name(const std::string &path) {
     const std::filesystem::path p(path);
-    const std::string name = "." + p.filename().string() + "." + std::to_string(getpid()) + ".tmp";
-    return (p.parent_path() / name).string();
+    return (p.parent_path() / fmt::format(".{}.{}.tmp", p.filename().string(), getpid())).string();
 }
 
 // fsync, so that the rename cannot reach the disk before the data does (after a crash the name would

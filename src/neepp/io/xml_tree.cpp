@@ -234,10 +234,17 @@ public:
 
     std::shared_ptr<XmlNode> parse(const std::string &path) {
         std::shared_ptr<XmlNode> root = parse_file(path, 0);
-        std::set<const XmlNode *> seen;
-        resolve_refs(*root, seen);
-        std::set<const XmlNode *> done, active;
-        check_cycles(*root, done, active);
+        try {
+            std::set<const XmlNode *> seen;
+            resolve_refs(*root, seen);
+            std::set<const XmlNode *> done, active;
+            check_cycles(*root, done, active);
+        } catch (...) {
+            // A <ref> cycle is a cycle of shared_ptrs, which would outlive the error: every cycle passes
+            // through an object with an id (what a <ref> points to), so unlinking their children frees it.
+            for (auto &[id, node] : ids_) node->children.clear();
+            throw;
+        }
         return root;
     }
 

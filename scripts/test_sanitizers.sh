@@ -1,0 +1,12 @@
+#!/usr/bin/env bash
+# The C++ test suite under AddressSanitizer + UndefinedBehaviorSanitizer: out-of-bounds reads and writes,
+# use after free, leaks, signed overflow, misaligned or null accesses, bad shifts and casts each fail
+# the test that trips them. One clang build (build-sanitize/) serves this and the fuzz targets
+# (scripts/fuzz.sh): for x86-64-v3, so it runs alike on any AVX2 or AVX-512 machine, at -O1, so it
+# builds quickly. scripts/test.sh runs it. Usage: scripts/test_sanitizers.sh [ctest arguments]
+set -euo pipefail
+ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
+"$ROOT/scripts/build_sanitized.sh"
+export ASAN_OPTIONS="detect_leaks=1:strict_string_checks=1:detect_stack_use_after_return=1"
+export UBSAN_OPTIONS="print_stacktrace=1:halt_on_error=1"
+ctest --test-dir "$ROOT/build-sanitize" --output-on-failure -j"$(nproc)" "$@"
