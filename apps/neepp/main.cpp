@@ -14,6 +14,7 @@
 #include "neepp/loader/scene_loader.h"
 #include "neepp/render/huge_pages.h"
 #include "neepp/render/render_output.h"
+#include "neepp/visibility/map_file.h"
 
 #ifndef NEEPP_SCENES_DIR
 #define NEEPP_SCENES_DIR "scenes"
@@ -42,7 +43,8 @@ std::pair<std::string, std::string> split_key_value(const std::string &s, const 
 struct RenderArgs {
     std::string scene, output = "render.exr", integrator, stats, sampler, rfilter, visibility_map;
     int spp = 0, threads = 0;
-    double time_s = 0;
+    double time_s = 0, checkpoint_s = 0;
+    bool resume = false;
     uint64_t seed = 0;
     std::vector<std::string> defines, integrator_options;
     bool quiet = false;
@@ -67,6 +69,36 @@ void check_output_path(const std::string &path, const char *what, const char *ex
     if (access(dir.c_str(), W_OK) != 0)
         throw std::runtime_error(fmt::format("cannot write the {} '{}': the folder '{}' is not writable", what, path,
                                              dir.string()));
+}
+
+// What a checkpoint must match to be resumed: the same scene (file and geometry), integrator and
+// options, seed, sampler, film and filter.
+nlohmann::json render_identity(const neepp::Scene &scene, const neepp::Integrator &integrator, const neepp::RenderJob &job,
+                               const std::map<std::string, std::string> &defines) {
+    return {{"scene", std::filesystem::absolute(scene.source_path).lexically_normal().string()},
+            {"scene_fingerprint", fmt::format("{:016x}", neepp::scene_fingerprint(scene))},
+            {"parameters", defines},
+            {"integrator", integrator.describe()},
+            {"seed", job.seed},
+            {"sampler", job.sampler},
+            {"film", fmt::format("{}x{}", scene.camera.width, scene.camera.height)},
+            {"rfilter", fmt::format("{} {} {}", scene.settings.rfilter, scene.settings.rfilter_radius,
+                                    scene.settings.rfilter_stddev)}};
+}
+
+// Reads the checkpoint a --resume continues and checks that it is this render's.
+neepp::RenderCheckpoint checkpoint_to_resume(const std::string &path, const nlohmann::json &identity) {
+    if (!std::filesystem::exists(path))
+        throw std::runtime_error(fmt::format("--resume: no checkpoint '{}' (a render with --checkpoint writes it)", path));
+    neepp::RenderCheckpoint c = neepp::load_checkpoint(path);
+    const nlohmann::json theirs = nlohmann::json::parse(c.identity);
+    for (const auto &[key, mine] : identity.items())
+        if (!theirs.contains(key) || theirs[key] != mine) {
+            const std::string was = theirs.contains(key) ? theirs[key].dump() : "missing";
+            throw std::runtime_error(fmt::format("--resume: the checkpoint '{}' is of another render: its {} is {}, this "
+                                                 "render's is {}", path, key, was, mine.dump()));
+        }
+    return c;
 }
 
 struct Rendered {
@@ -108,6 +140,24 @@ Rendered run_render(const RenderArgs &a) {
     job.sampler = a.sampler.empty() ? scene->settings.sampler : a.sampler;
     job.progress = !a.quiet && isatty(STDERR_FILENO);
     job.cancel = &g_cancel;
+    // --checkpoint writes the render's state beside the image (OUTPUT.checkpoint) and the image so far;
+    // --resume continues from that state. A render that reaches its sample count removes it.
+    const std::string checkpoint_path = a.output + ".checkpoint";
+    const nlohmann::json identity = render_identity(*scene, *integrator, job, defines);
+    neepp::RenderCheckpoint resumed;
+    if (a.resume) {
+        resumed = checkpoint_to_resume(checkpoint_path, identity);
+        job.resume = &resumed;
+    }
+    if (a.checkpoint_s > 0) {
+        job.checkpoint_interval_s = a.checkpoint_s;
+        job.on_checkpoint = [&](const neepp::RenderCheckpoint &c, const neepp::Image &image) {
+            neepp::RenderCheckpoint with_identity = c;
+            with_identity.identity = identity.dump();
+            neepp::save_checkpoint(checkpoint_path, with_identity);
+            neepp::write_render_images(a.output, image);
+        };
+    }
     if (!a.quiet)
         fmt::print(stderr, "neepp: {} ({}x{}, {} triangles, {} lights, loaded in {:.2f} s), integrator {}, {}\n",
                    a.scene, scene->camera.width, scene->camera.height, scene->triangle_count(), scene->lights().size(),
@@ -116,6 +166,7 @@ Rendered run_render(const RenderArgs &a) {
 
     neepp::RenderResult result = neepp::render(*scene, *integrator, job);
     std::string png = neepp::write_render_images(a.output, result.image);
+    if ((a.resume || a.checkpoint_s > 0) && result.stopped_by == "spp") std::filesystem::remove(checkpoint_path);
     nlohmann::json stats = neepp::render_statistics(*scene, *integrator, result, job);
     stats["load_time_s"] = load_s;
     if (!a.stats.empty()) neepp::write_file_atomically(a.stats, stats.dump(2) + "\n");
@@ -255,6 +306,13 @@ int main(int argc, char **argv) {
     render->add_option("--visibility-map", ra.visibility_map,
                        "NEE++ visibility map file: loaded if it exists and belongs to this scene, else built and saved");
     render->add_option("--stats", ra.stats, "Write statistics JSON here");
+    render->add_option("--checkpoint", ra.checkpoint_s,
+                       "Every this many seconds, and when stopped early, save the render's state to OUTPUT.checkpoint "
+                       "and write the image so far")
+        ->check(CLI::PositiveNumber);
+    render->add_flag("--resume", ra.resume,
+                     "Continue the render saved in OUTPUT.checkpoint (same scene, options and seed) to the same image an "
+                     "uninterrupted render gives");
     render->add_flag("-q,--quiet", ra.quiet, "No progress bar or messages");
 
     std::string demo_dir = "neepp-demo";

@@ -61,6 +61,9 @@ public:
     // Whether end_pass changes what later samples do (NEE++ publishes a new map): the render loop then
     // starts with small passes, so that it learns early. Asked after prepare().
     virtual bool learns_between_passes() const { return false; }
+    // Whether a render with this integrator can be checkpointed and resumed (--checkpoint, --resume): it
+    // can when end_pass learns nothing that a checkpoint would have to carry.
+    virtual bool supports_checkpoints() const { return true; }
     // Name and effective options, for the statistics file.
     virtual nlohmann::json describe() const = 0;
     // Extra statistics of this integrator (map size, rays skipped...), merged into the stats file.

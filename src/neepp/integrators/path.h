@@ -28,6 +28,8 @@ public:
     void end_pass(const Scene &scene, const PassStatistics &pass) override;
     // While the shadow-ray policy reads or updates its visibility map (which the light sampler may read too).
     bool learns_between_passes() const override { return shadow_->learns_between_passes(); }
+    // NEE++'s tester keeps a map (and a phase and a calibration) between passes; plain NEE keeps nothing.
+    bool supports_checkpoints() const override { return shadow_->visibility_map() == nullptr; }
     nlohmann::json statistics() const override;
     Color Li(const Scene &scene, const Ray &ray, Sampler &sampler, RenderCounters &counters) const override;
     // Paths of a batch advance in lockstep, one bounce at a time and stage by stage, each stage issuing

@@ -71,6 +71,22 @@ Image SplatFilm::resolve(double scale) const {
     return img;
 }
 
+std::vector<int64_t> SplatFilm::sums() const {
+    std::vector<int64_t> out(size_t(width_) * height_ * 3);
+    for (size_t i = 0; i < out.size(); ++i) out[i] = sums_[i].load(std::memory_order_relaxed);
+    return out;
+}
+
+void SplatFilm::set_sums(const std::vector<int64_t> &sums) {
+    if (sums.size() != size_t(width_) * height_ * 3) throw std::invalid_argument("SplatFilm::set_sums: wrong size");
+    for (size_t i = 0; i < sums.size(); ++i) sums_[i].store(sums[i], std::memory_order_relaxed);
+}
+
+void ImageBlock::set_sums(std::vector<double> sums) {
+    if (sums.size() != sums_.size()) throw std::invalid_argument("ImageBlock::set_sums: wrong size");
+    sums_ = std::move(sums);
+}
+
 ImageBlock::ImageBlock(int x0, int y0, int width, int height, const ReconstructionFilter *filter)
     : x0_(x0), y0_(y0), width_(width), height_(height), filter_(filter), sums_(size_t(width) * height * 4, 0.0) {}
 

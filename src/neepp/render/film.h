@@ -53,6 +53,9 @@ public:
     void clear();
     // The sums times scale, per pixel.
     Image resolve(double scale) const;
+    // The fixed-point sums (r, g, b per pixel), as a checkpoint stores them, and their restoration.
+    std::vector<int64_t> sums() const;
+    void set_sums(const std::vector<int64_t> &sums);
     int width() const { return width_; }
     int height() const { return height_; }
 
@@ -81,6 +84,10 @@ public:
     int height() const { return height_; }
     // Resolved image: Σ w·L / Σ w per pixel (black where no weight).
     Image resolve() const;
+    // The raw sums (r, g, b, weight per pixel, row-major), as a checkpoint stores them; set_sums takes
+    // back exactly what sums() gave (throws std::invalid_argument on another size).
+    const std::vector<double> &sums() const { return sums_; }
+    void set_sums(std::vector<double> sums);
 
 private:
     int x0_, y0_, width_, height_;

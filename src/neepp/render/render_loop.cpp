@@ -106,10 +106,17 @@ RenderResult render(const Scene &scene, Integrator &integrator, const RenderJob 
     tbb::global_control limit(tbb::global_control::max_allowed_parallelism, size_t(threads));
     tbb::task_arena arena(threads);
 
+    const bool checkpoints = job.on_checkpoint || job.resume;
+    if (checkpoints && !integrator.supports_checkpoints())
+        throw std::invalid_argument(
+            "checkpoints: this integrator learns between passes (NEE++'s visibility map, its policy's "
+            "calibration), state that checkpoints do not hold yet, so a resumed render would not continue "
+            "the same render; render it without --checkpoint and --resume");
     RenderResult result;
     tbb::enumerable_thread_specific<RenderCounters> counters;
     const Clock::time_point start = Clock::now();
-    auto elapsed = [&] { return std::chrono::duration<double>(Clock::now() - start).count(); };
+    const double time_before = job.resume ? job.resume->render_time_s : 0.0;  // a resumed render's earlier time
+    auto elapsed = [&] { return time_before + std::chrono::duration<double>(Clock::now() - start).count(); };
 
     std::vector<double> tile_m2(tiles.size());  // Σ lum(L)² per tile this pass, summed in tile order
     std::atomic<int> tiles_done{0};
@@ -124,6 +131,44 @@ RenderResult render(const Scene &scene, Integrator &integrator, const RenderJob 
 
     integrator.prepare(scene);
     double seconds_per_spp = 0;
+    RenderCounters counters_before;  // a resumed render's
+    if (job.resume) {
+        const RenderCheckpoint &c = *job.resume;
+        if (splatting != !c.splat_sums.empty()) throw std::invalid_argument("resume: the checkpoint's splats do not match the integrator");
+        accumulated.set_sums(c.image_sums);
+        if (splatting) splats_accumulated->set_sums(c.splat_sums);
+        light_paths = c.light_paths;
+        result.spp = result.resumed_spp = c.spp;
+        result.passes = c.passes;
+        seconds_per_spp = c.seconds_per_spp;
+        counters_before = c.counters;
+        spp_done_now = result.spp;
+    }
+    // The image so far: the accumulated samples plus the splat layer, scaled by pixels / light paths.
+    auto current_image = [&] {
+        Image image = accumulated.resolve();
+        if (splatting && light_paths > 0) {
+            const Image splat = splats_accumulated->resolve(double(W) * H / light_paths);
+            for (size_t i = 0; i < image.data.size(); ++i) image.data[i] += splat.data[i];
+        }
+        return image;
+    };
+    double last_checkpoint = elapsed();
+    bool checkpointed_at_stop = false;
+    auto checkpoint = [&] {
+        RenderCheckpoint c;
+        c.spp = result.spp;
+        c.passes = result.passes;
+        c.render_time_s = elapsed();
+        c.seconds_per_spp = seconds_per_spp;
+        c.light_paths = light_paths;
+        c.counters = counters_before;
+        for (const RenderCounters &t : counters) c.counters += t;
+        c.image_sums = accumulated.sums();
+        if (splatting) c.splat_sums = splats_accumulated->sums();
+        job.on_checkpoint(c, current_image());
+        last_checkpoint = elapsed();
+    };
     for (;;) {
         if (job.cancel && job.cancel->load()) { result.stopped_by = "cancel"; break; }
         double remaining = timed ? job.time_limit_s - elapsed() : 0;
@@ -211,6 +256,9 @@ RenderResult render(const Scene &scene, Integrator &integrator, const RenderJob 
             });
         });
         if (aborted) {
+            // A checkpoint holds whole passes: the one cut short is not in it (nor in a resumed image).
+            if (job.on_checkpoint && result.passes > 0) checkpoint();
+            checkpointed_at_stop = true;
             // Keep a partial first pass rather than nothing at all: every pixel it reached is unbiased.
             if (result.passes == 0) {
                 accumulated.merge(pass_block);
@@ -233,18 +281,18 @@ RenderResult render(const Scene &scene, Integrator &integrator, const RenderJob 
         ++result.passes;
         seconds_per_spp = (elapsed() - pass_start) / size;
         if (job.spp > 0 && result.spp >= job.spp) { result.stopped_by = "spp"; break; }
+        if (job.on_checkpoint && elapsed() - last_checkpoint >= job.checkpoint_interval_s) checkpoint();
     }
+    // Stopped before its sample count between passes (time, Ctrl-C): what a resume continues from.
+    if (job.on_checkpoint && result.stopped_by != "spp" && !checkpointed_at_stop && result.passes > 0) checkpoint();
     pass_size_now = 0;
     bar.finish();
 
     result.render_time_s = elapsed();
+    result.counters = counters_before;
     for (const RenderCounters &c : counters) result.counters += c;
     result.occlusion_time_s = double(result.counters.occlusion_ticks) * seconds_per_tick();
-    result.image = accumulated.resolve();
-    if (splatting && light_paths > 0) {
-        const Image splat = splats_accumulated->resolve(double(W) * H / light_paths);
-        for (size_t i = 0; i < result.image.data.size(); ++i) result.image.data[i] += splat.data[i];
-    }
+    result.image = current_image();
     return result;
 }
 

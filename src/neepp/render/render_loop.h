@@ -1,11 +1,13 @@
 // The render loop owns time: it renders the image in passes of whole-image samples, over tiles on a TBB
 // thread pool, until the sample count or the time budget is reached or it is cancelled (Ctrl-C), and
 // always hands back the image of the passes completed so far. Integrators get a hook between passes.
+// It can save its state at pass boundaries and continue from such a checkpoint.
 #pragma once
 #include <atomic>
 #include <functional>
 #include <string>
 #include "neepp/io/image.h"
+#include "neepp/render/checkpoint.h"
 #include "neepp/render/stats.h"
 
 namespace neepp {
@@ -22,6 +24,13 @@ struct RenderJob {
     bool progress = false;        // draw a progress bar with ETA on stderr
     const std::atomic<bool> *cancel = nullptr;  // set asynchronously (e.g. by SIGINT) to stop early
     int tile_size = 32;
+    // Checkpoints: at the end of a pass, once checkpoint_interval_s has passed since the last, and when
+    // the render stops before its sample count (time, cancel), on_checkpoint gets the render's state and
+    // its image so far. `resume` continues the render a checkpoint holds (same scene, integrator, seed
+    // and sampler: the caller checks its identity) to the sums an uninterrupted render reaches.
+    double checkpoint_interval_s = 0;
+    std::function<void(const RenderCheckpoint &, const Image &)> on_checkpoint;
+    const RenderCheckpoint *resume = nullptr;
 };
 
 struct RenderResult {
@@ -32,6 +41,7 @@ struct RenderResult {
     RenderCounters counters;
     double occlusion_time_s = 0;
     std::string stopped_by = "spp";  // spp, time, cancel
+    int resumed_spp = 0;             // samples per pixel the render was resumed with (0: not resumed)
 };
 
 RenderResult render(const Scene &scene, Integrator &integrator, const RenderJob &job);

@@ -35,6 +35,7 @@ nlohmann::json render_statistics(const Scene &scene, const Integrator &integrato
         {"spp", r.spp},
         {"passes", r.passes},
         {"stopped_by", r.stopped_by},
+        {"resumed_spp", r.resumed_spp},
         {"width", scene.camera.width},
         {"height", scene.camera.height},
         {"seed", job.seed},

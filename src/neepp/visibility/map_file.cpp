@@ -1,11 +1,10 @@
 #include "neepp/visibility/map_file.h"
 
 #include <cstring>
-#include <fstream>
-#include <iterator>
 #include <stdexcept>
 #include <fmt/format.h>
 #include "neepp/io/atomic_file.h"
+#include "neepp/io/binary_io.h"
 #include "neepp/scene/scene.h"
 
 namespace neepp {
@@ -15,34 +14,7 @@ namespace {
 constexpr char kMagic[8] = {'N', 'E', 'E', 'P', 'P', 'V', 'I', 'S'};
 constexpr uint32_t kVersion = 1;
 
-struct Writer {
-    std::string bytes;
-    template <typename T> void put(const T &v) { bytes.append(reinterpret_cast<const char *>(&v), sizeof(T)); }
-};
-
-struct Reader {
-    const std::string &bytes;
-    size_t pos = 0;
-    const std::string &path;
-    template <typename T> T get() {
-        if (pos + sizeof(T) > bytes.size()) throw std::runtime_error(fmt::format("visibility map '{}': file is truncated", path));
-        T v;
-        std::memcpy(&v, bytes.data() + pos, sizeof(T));
-        pos += sizeof(T);
-        return v;
-    }
-};
-
 }  // namespace
-
-uint64_t fnv1a64(const void *data, size_t bytes, uint64_t hash) {
-    const unsigned char *p = static_cast<const unsigned char *>(data);
-    for (size_t i = 0; i < bytes; ++i) {
-        hash ^= p[i];
-        hash *= 0x100000001b3ULL;
-    }
-    return hash;
-}
 
 uint64_t scene_fingerprint(const Scene &scene) {
     uint64_t h = fnv1a64("neepp-scene-v1", 14);
@@ -73,7 +45,7 @@ uint64_t scene_fingerprint(const Scene &scene) {
 void save_visibility_map(const std::string &path, const VoxelGrid &grid, const VisibilityMap &map, uint64_t fingerprint) {
     if (map.cell_count() != grid.cell_count())
         throw std::invalid_argument("save_visibility_map: map and grid have different cell counts");
-    Writer w;
+    BinaryWriter w;
     w.bytes.append(kMagic, 8);
     w.put(kVersion);
     w.put(uint32_t(grid.resolution()));
@@ -98,9 +70,7 @@ void save_visibility_map(const std::string &path, const VoxelGrid &grid, const V
 }
 
 VisibilityMap load_visibility_map(const std::string &path, const VoxelGrid &grid, uint64_t fingerprint) {
-    std::ifstream in(path, std::ios::binary);
-    if (!in) throw std::runtime_error(fmt::format("visibility map '{}': cannot open", path));
-    std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    const std::string bytes = read_file_bytes(path, fmt::format("visibility map '{}'", path));
     auto fail = [&](const std::string &why) { return std::runtime_error(fmt::format("visibility map '{}': {}", path, why)); };
     if (bytes.size() < 8 || std::memcmp(bytes.data(), kMagic, 8) != 0) throw fail("not a neepp visibility map (bad magic)");
     if (bytes.size() < 8 + 4 + 8) throw fail("file is truncated");
@@ -108,7 +78,7 @@ VisibilityMap load_visibility_map(const std::string &path, const VoxelGrid &grid
     uint64_t stored;
     std::memcpy(&stored, bytes.data() + bytes.size() - 8, 8);
     uint64_t actual = fnv1a64(bytes.data(), bytes.size() - 8);
-    Reader r{bytes, 8, path};
+    BinaryReader r{bytes, 8, fmt::format("visibility map '{}'", path)};
     uint32_t version = r.get<uint32_t>();
     if (version != kVersion) throw fail(fmt::format("unsupported version {} (this build reads version {})", version, kVersion));
     if (stored != actual)

@@ -9,15 +9,13 @@
 #pragma once
 #include <cstdint>
 #include <string>
+#include "neepp/io/checksum.h"
 #include "neepp/visibility/visibility_map.h"
 #include "neepp/visibility/voxel_grid.h"
 
 namespace neepp {
 
 class Scene;
-
-// 64-bit FNV-1a, the checksum of map files (no new dependency; detects any single flipped byte).
-uint64_t fnv1a64(const void *data, size_t bytes, uint64_t hash = 0xcbf29ce484222325ULL);
 
 // A hash of what visibility depends on: every shape's geometry (positions, indices, spheres), the
 // lights' kinds and the scene bounds. Materials, textures and the camera do not change visibility, so a

@@ -1,0 +1,60 @@
+// Little helpers for the project's own binary files (visibility maps, render checkpoints): values are
+// appended and read back in this machine's byte order, with a clear error on a file too short.
+#pragma once
+#include <cstring>
+#include <fstream>
+#include <iterator>
+#include <stdexcept>
+#include <string>
+#include <type_traits>
+#include <vector>
+
+namespace neepp {
+
+struct BinaryWriter {
+    std::string bytes;
+    template <typename T> void put(const T &v) {
+        static_assert(std::is_trivially_copyable_v<T>);
+        bytes.append(reinterpret_cast<const char *>(&v), sizeof(T));
+    }
+    // A count, then the elements.
+    template <typename T> void put_vector(const std::vector<T> &v) {
+        static_assert(std::is_trivially_copyable_v<T>);
+        put(uint64_t(v.size()));
+        bytes.append(reinterpret_cast<const char *>(v.data()), v.size() * sizeof(T));
+    }
+};
+
+struct BinaryReader {
+    const std::string &bytes;
+    size_t pos = 0;
+    std::string what;  // prefix of errors, e.g. "visibility map 'a.map'"
+    template <typename T> T get() {
+        static_assert(std::is_trivially_copyable_v<T>);
+        need(sizeof(T));
+        T v;
+        std::memcpy(&v, bytes.data() + pos, sizeof(T));
+        pos += sizeof(T);
+        return v;
+    }
+    template <typename T> std::vector<T> get_vector() {
+        const uint64_t n = get<uint64_t>();
+        if (n > (bytes.size() - pos) / sizeof(T)) throw std::runtime_error(what + ": file is truncated");
+        std::vector<T> v(n);
+        std::memcpy(v.data(), bytes.data() + pos, n * sizeof(T));
+        pos += n * sizeof(T);
+        return v;
+    }
+    void need(size_t n) const {
+        if (n > bytes.size() - pos) throw std::runtime_error(what + ": file is truncated");
+    }
+};
+
+// The whole file, or std::runtime_error("<what>: cannot open").
+inline std::string read_file_bytes(const std::string &path, const std::string &what) {
+    std::ifstream in(path, std::ios::binary);
+    if (!in) throw std::runtime_error(what + ": cannot open");
+    return std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+}
+
+}  // namespace neepp
