@@ -12,14 +12,15 @@ using namespace neepp::testing;
 
 namespace {
 
-std::unique_ptr<Scene> demo_scene() {
-    return load_scene(std::string(NEEPP_SOURCE_DIR) + "/scenes/door-ajar/scene.xml", {{"resx", "40"}, {"resy", "24"}});
+std::unique_ptr<Scene> project_scene(const std::string &name) {
+    return load_scene(std::string(NEEPP_SOURCE_DIR) + "/scenes/" + name + "/scene.xml", {{"resx", "40"}, {"resy", "24"}});
 }
 
 // Renders to spp in one go, then to `first` spp with a checkpoint after every pass, then resumes each
 // checkpoint to spp: every resumed image must be identical to the uninterrupted one.
-void expect_resume_is_exact(const std::string &integrator_name, const OptionMap &o, int first, int spp) {
-    auto scene = demo_scene();
+void expect_resume_is_exact(const std::string &integrator_name, const OptionMap &o, int first, int spp,
+                            const std::string &scene_name = "door-ajar") {
+    auto scene = project_scene(scene_name);
     Options options(scene->settings.integrator_options);
     for (const auto &[k, v] : o) options.set(k, v);
     RenderJob job;
@@ -59,14 +60,19 @@ TEST(Checkpoint, BdptResumesToTheSameImageSplatsIncluded) { expect_resume_is_exa
 
 TEST(Checkpoint, LightTracingResumesToTheSameImage) { expect_resume_is_exact("light", {}, 5, 9); }
 
-TEST(Checkpoint, AnIntegratorThatLearnsIsRefused) {
-    auto scene = demo_scene();
-    auto integ = make_integrator("path", Options(OptionMap{{"shadow_rays", "neepp"}}));
-    RenderJob job;
-    job.spp = 2;
-    job.checkpoint_interval_s = 1;
-    job.on_checkpoint = [](const RenderCheckpoint &, const Image &) {};
-    EXPECT_THROW(render(*scene, *integ, job), std::invalid_argument);
+// NEE++ learns between passes: the map, the first pass's decision to reject or not, the adaptive
+// policy's calibration. A resumed render must read in each pass what the uninterrupted one read.
+TEST(Checkpoint, NeeppResumesToTheSameImage) {
+    expect_resume_is_exact("path", {{"shadow_rays", "neepp"}}, 12, 20);
+    expect_resume_is_exact("path", {{"shadow_rays", "neepp-adaptive"}}, 12, 20);
+}
+
+TEST(Checkpoint, VisibilityAwareLightSelectionResumesToTheSameImage) {
+    expect_resume_is_exact("path", {{"light_sampler", "visibility"}, {"shadow_rays", "neepp-adaptive"}}, 12, 20, "office");
+}
+
+TEST(Checkpoint, BdptWithNeeppSelectionResumesToTheSameImage) {
+    expect_resume_is_exact("bdpt", {{"light_paths", "neepp"}}, 6, 9);
 }
 
 TEST(Checkpoint, FilesRoundTripAndRefuseDamage) {

@@ -68,6 +68,11 @@ void BDPTIntegrator::end_pass(const Scene &, const PassStatistics &pass) {
     queries_ = &shadow_->query_tester();
 }
 
+void BDPTIntegrator::restore_state(const Scene &, const std::string &state) {
+    shadow_->restore_state(state);
+    queries_ = &shadow_->query_tester();
+}
+
 nlohmann::json BDPTIntegrator::describe() const {
     nlohmann::json j = {{"name", options_.light_tracer ? "light" : "bdpt"},
                         {"max_depth", options_.max_depth},

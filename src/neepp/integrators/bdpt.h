@@ -54,8 +54,9 @@ public:
     uint64_t begin_pass(const Scene &scene, const PassInfo &pass, SplatFilm &splats, RenderCounters &counters) override;
     void end_pass(const Scene &scene, const PassStatistics &pass) override;
     bool learns_between_passes() const override { return shadow_->learns_between_passes(); }
-    // NEE++'s tester keeps a map (and a phase and a calibration) between passes; plain NEE keeps nothing.
-    bool supports_checkpoints() const override { return shadow_->visibility_map() == nullptr; }
+    // What the shadow-ray component has learned (NEE++'s map, phase, calibration).
+    std::string save_state() const override { return shadow_->save_state(); }
+    void restore_state(const Scene &scene, const std::string &state) override;
     nlohmann::json describe() const override;
     nlohmann::json statistics() const override;
     const BDPTOptions &options() const { return options_; }

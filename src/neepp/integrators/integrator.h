@@ -61,9 +61,11 @@ public:
     // Whether end_pass changes what later samples do (NEE++ publishes a new map): the render loop then
     // starts with small passes, so that it learns early. Asked after prepare().
     virtual bool learns_between_passes() const { return false; }
-    // Whether a render with this integrator can be checkpointed and resumed (--checkpoint, --resume): it
-    // can when end_pass learns nothing that a checkpoint would have to carry.
-    virtual bool supports_checkpoints() const { return true; }
+    // Render checkpoints (--checkpoint, --resume): what end_pass has learned so far, as bytes, and its
+    // restoration right after prepare(), so that a resumed render continues the one that was stopped.
+    // An integrator that keeps anything between passes must carry it here.
+    virtual std::string save_state() const { return {}; }
+    virtual void restore_state(const Scene &scene, const std::string &state) {}
     // Name and effective options, for the statistics file.
     virtual nlohmann::json describe() const = 0;
     // Extra statistics of this integrator (map size, rays skipped...), merged into the stats file.

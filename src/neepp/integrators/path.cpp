@@ -44,6 +44,12 @@ void PathIntegrator::end_pass(const Scene &, const PassStatistics &pass) {
     light_sampler_->end_pass();  // ... and rebuild the light distributions that read it
 }
 
+void PathIntegrator::restore_state(const Scene &, const std::string &state) {
+    shadow_->restore_state(state);
+    queries_ = &shadow_->query_tester();
+    light_sampler_->end_pass();  // its distributions read the restored map
+}
+
 nlohmann::json PathIntegrator::statistics() const {
     nlohmann::json out = nlohmann::json::object();
     if (nlohmann::json s = shadow_->statistics(); !s.empty()) out["shadow_rays"] = s;

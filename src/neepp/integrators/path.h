@@ -28,8 +28,9 @@ public:
     void end_pass(const Scene &scene, const PassStatistics &pass) override;
     // While the shadow-ray policy reads or updates its visibility map (which the light sampler may read too).
     bool learns_between_passes() const override { return shadow_->learns_between_passes(); }
-    // NEE++'s tester keeps a map (and a phase and a calibration) between passes; plain NEE keeps nothing.
-    bool supports_checkpoints() const override { return shadow_->visibility_map() == nullptr; }
+    // What the shadow-ray component has learned (NEE++'s map, phase, calibration).
+    std::string save_state() const override { return shadow_->save_state(); }
+    void restore_state(const Scene &scene, const std::string &state) override;
     nlohmann::json statistics() const override;
     Color Li(const Scene &scene, const Ray &ray, Sampler &sampler, RenderCounters &counters) const override;
     // Paths of a batch advance in lockstep, one bounce at a time and stage by stage, each stage issuing

@@ -23,6 +23,10 @@ struct BinaryWriter {
         put(uint64_t(v.size()));
         bytes.append(reinterpret_cast<const char *>(v.data()), v.size() * sizeof(T));
     }
+    void put_string(const std::string &s) {
+        put(uint64_t(s.size()));
+        bytes.append(s);
+    }
 };
 
 struct BinaryReader {
@@ -44,6 +48,13 @@ struct BinaryReader {
         std::memcpy(v.data(), bytes.data() + pos, n * sizeof(T));
         pos += n * sizeof(T);
         return v;
+    }
+    std::string get_string() {
+        const uint64_t n = get<uint64_t>();
+        need(n);
+        std::string s = bytes.substr(pos, n);
+        pos += n;
+        return s;
     }
     void need(size_t n) const {
         if (n > bytes.size() - pos) throw std::runtime_error(what + ": file is truncated");

@@ -19,7 +19,7 @@ void save_checkpoint(const std::string &path, const RenderCheckpoint &c) {
     BinaryWriter w;
     w.bytes.append(kMagic, 8);
     w.put(kVersion);
-    w.put_vector(std::vector<char>(c.identity.begin(), c.identity.end()));
+    w.put_string(c.identity);
     w.put(int32_t(c.spp));
     w.put(int32_t(c.passes));
     w.put(c.render_time_s);
@@ -28,6 +28,7 @@ void save_checkpoint(const std::string &path, const RenderCheckpoint &c) {
     w.put(c.counters);
     w.put_vector(c.image_sums);
     w.put_vector(c.splat_sums);
+    w.put_string(c.integrator_state);
     w.put(fnv1a64(w.bytes.data(), w.bytes.size()));
     try {
         write_file_atomically(path, w.bytes);
@@ -50,8 +51,7 @@ RenderCheckpoint load_checkpoint(const std::string &path) {
     if (const uint32_t version = r.get<uint32_t>(); version != kVersion)
         throw std::runtime_error(fmt::format("{}: unsupported version {} (this build reads version {})", what, version, kVersion));
     RenderCheckpoint c;
-    const std::vector<char> identity = r.get_vector<char>();
-    c.identity.assign(identity.begin(), identity.end());
+    c.identity = r.get_string();
     c.spp = r.get<int32_t>();
     c.passes = r.get<int32_t>();
     c.render_time_s = r.get<double>();
@@ -60,6 +60,7 @@ RenderCheckpoint load_checkpoint(const std::string &path) {
     c.counters = r.get<RenderCounters>();
     c.image_sums = r.get_vector<double>();
     c.splat_sums = r.get_vector<int64_t>();
+    c.integrator_state = r.get_string();
     if (r.pos != body.size() || c.spp < 1 || c.passes < 1) throw std::runtime_error(what + ": malformed");
     return c;
 }

@@ -22,6 +22,7 @@ struct RenderCheckpoint {
     RenderCounters counters;
     std::vector<double> image_sums;   // ImageBlock::sums() of the whole image
     std::vector<int64_t> splat_sums;  // SplatFilm::sums(); empty for integrators that do not splat
+    std::string integrator_state;     // Integrator::save_state()
 };
 
 // Writes the checkpoint atomically (see atomic_file.h), with a checksum.

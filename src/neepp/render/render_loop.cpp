@@ -106,12 +106,6 @@ RenderResult render(const Scene &scene, Integrator &integrator, const RenderJob 
     tbb::global_control limit(tbb::global_control::max_allowed_parallelism, size_t(threads));
     tbb::task_arena arena(threads);
 
-    const bool checkpoints = job.on_checkpoint || job.resume;
-    if (checkpoints && !integrator.supports_checkpoints())
-        throw std::invalid_argument(
-            "checkpoints: this integrator learns between passes (NEE++'s visibility map, its policy's "
-            "calibration), state that checkpoints do not hold yet, so a resumed render would not continue "
-            "the same render; render it without --checkpoint and --resume");
     RenderResult result;
     tbb::enumerable_thread_specific<RenderCounters> counters;
     const Clock::time_point start = Clock::now();
@@ -143,6 +137,7 @@ RenderResult render(const Scene &scene, Integrator &integrator, const RenderJob 
         seconds_per_spp = c.seconds_per_spp;
         counters_before = c.counters;
         spp_done_now = result.spp;
+        integrator.restore_state(scene, c.integrator_state);
     }
     // The image so far: the accumulated samples plus the splat layer, scaled by pixels / light paths.
     auto current_image = [&] {
@@ -166,6 +161,7 @@ RenderResult render(const Scene &scene, Integrator &integrator, const RenderJob 
         for (const RenderCounters &t : counters) c.counters += t;
         c.image_sums = accumulated.sums();
         if (splatting) c.splat_sums = splats_accumulated->sums();
+        c.integrator_state = integrator.save_state();
         job.on_checkpoint(c, current_image());
         last_checkpoint = elapsed();
     };

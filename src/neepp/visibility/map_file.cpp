@@ -42,9 +42,9 @@ uint64_t scene_fingerprint(const Scene &scene) {
     return h;
 }
 
-void save_visibility_map(const std::string &path, const VoxelGrid &grid, const VisibilityMap &map, uint64_t fingerprint) {
+std::string encode_visibility_map(const VoxelGrid &grid, const VisibilityMap &map, uint64_t fingerprint) {
     if (map.cell_count() != grid.cell_count())
-        throw std::invalid_argument("save_visibility_map: map and grid have different cell counts");
+        throw std::invalid_argument("encode_visibility_map: map and grid have different cell counts");
     BinaryWriter w;
     w.bytes.append(kMagic, 8);
     w.put(kVersion);
@@ -62,23 +62,33 @@ void save_visibility_map(const std::string &path, const VoxelGrid &grid, const V
             w.put(data[i].traced);
         }
     w.put(fnv1a64(w.bytes.data(), w.bytes.size()));
+    return std::move(w.bytes);
+}
+
+void save_visibility_map(const std::string &path, const VoxelGrid &grid, const VisibilityMap &map, uint64_t fingerprint) {
+    const std::string bytes = encode_visibility_map(grid, map, fingerprint);
     try {
-        write_file_atomically(path, w.bytes);
+        write_file_atomically(path, bytes);
     } catch (const std::exception &e) {
         throw std::runtime_error(fmt::format("visibility map {}", e.what()));
     }
 }
 
 VisibilityMap load_visibility_map(const std::string &path, const VoxelGrid &grid, uint64_t fingerprint) {
-    const std::string bytes = read_file_bytes(path, fmt::format("visibility map '{}'", path));
-    auto fail = [&](const std::string &why) { return std::runtime_error(fmt::format("visibility map '{}': {}", path, why)); };
+    const std::string what = fmt::format("visibility map '{}'", path);
+    return decode_visibility_map(read_file_bytes(path, what), what, grid, fingerprint);
+}
+
+VisibilityMap decode_visibility_map(const std::string &bytes, const std::string &what, const VoxelGrid &grid,
+                                    uint64_t fingerprint) {
+    auto fail = [&](const std::string &why) { return std::runtime_error(fmt::format("{}: {}", what, why)); };
     if (bytes.size() < 8 || std::memcmp(bytes.data(), kMagic, 8) != 0) throw fail("not a neepp visibility map (bad magic)");
     if (bytes.size() < 8 + 4 + 8) throw fail("file is truncated");
     // Checksum first: a damaged file must not be read any further, whatever the damage.
     uint64_t stored;
     std::memcpy(&stored, bytes.data() + bytes.size() - 8, 8);
     uint64_t actual = fnv1a64(bytes.data(), bytes.size() - 8);
-    BinaryReader r{bytes, 8, fmt::format("visibility map '{}'", path)};
+    BinaryReader r{bytes, 8, what};
     uint32_t version = r.get<uint32_t>();
     if (version != kVersion) throw fail(fmt::format("unsupported version {} (this build reads version {})", version, kVersion));
     if (stored != actual)

@@ -36,4 +36,10 @@ void save_visibility_map(const std::string &path, const VoxelGrid &grid, const V
 // the mismatch otherwise.
 VisibilityMap load_visibility_map(const std::string &path, const VoxelGrid &grid, uint64_t fingerprint);
 
+// The same in memory (a render checkpoint carries a map): the file's bytes, and their checked reading,
+// whose errors start with `what`.
+std::string encode_visibility_map(const VoxelGrid &grid, const VisibilityMap &map, uint64_t fingerprint);
+VisibilityMap decode_visibility_map(const std::string &bytes, const std::string &what, const VoxelGrid &grid,
+                                    uint64_t fingerprint);
+
 }  // namespace neepp

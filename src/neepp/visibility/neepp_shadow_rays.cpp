@@ -5,6 +5,7 @@
 #include <filesystem>
 #include <stdexcept>
 #include <tuple>
+#include "neepp/io/binary_io.h"
 #include "neepp/sampling/sampler.h"
 #include "neepp/scene/scene.h"
 #include "neepp/visibility/map_file.h"
@@ -251,6 +252,35 @@ void NeeppShadowRays::end_pass(const PassStatistics &pass) {
     }
     ++totals_.passes;
     totals_.merge_time_s += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
+std::string NeeppShadowRays::save_state() const {
+    BinaryWriter w;
+    w.put(uint8_t(phase_));
+    w.put(adaptive_scale_);
+    w.put(totals_);
+    w.put(seeding_);
+    w.put_string(map_source_);
+    const bool has_map = map_.cell_count() != 0;
+    w.put(uint8_t(has_map));
+    if (has_map) w.put_string(encode_visibility_map(grid_, map_, 0));
+    return std::move(w.bytes);
+}
+
+void NeeppShadowRays::restore_state(const std::string &state) {
+    BinaryReader r{state, 0, "checkpoint: NEE++ state"};
+    const uint8_t phase = r.get<uint8_t>();
+    if (phase > uint8_t(Phase::Off)) throw std::runtime_error("checkpoint: NEE++ state: bad phase");
+    phase_ = Phase(phase);
+    adaptive_scale_ = r.get<double>();
+    totals_ = r.get<Totals>();
+    seeding_ = r.get<SeedingStats>();
+    map_source_ = r.get_string();
+    if (r.get<uint8_t>()) {
+        map_ = decode_visibility_map(r.get_string(), "checkpoint: NEE++ map", grid_, 0);
+    } else {
+        map_ = VisibilityMap();
+    }
 }
 
 nlohmann::json NeeppShadowRays::describe() const {

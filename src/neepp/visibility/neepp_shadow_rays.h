@@ -96,6 +96,9 @@ public:
     std::string policy() const override { return to_string(options_.policy); }
     void prepare(const Scene &scene) override;
     void end_pass(const PassStatistics &pass) override;
+    // The phase, the adaptive calibration, the totals and the map (its known pairs).
+    std::string save_state() const override;
+    void restore_state(const std::string &state) override;
     nlohmann::json describe() const override;
     nlohmann::json statistics() const override;
 

@@ -61,6 +61,10 @@ public:
     // merged map, frozen).
     virtual void prepare(const Scene &scene) {}
     virtual void end_pass(const PassStatistics &) {}
+    // A render checkpoint's share: what end_pass has learned so far, as bytes, and its restoration right
+    // after prepare(scene), so that a resumed render's passes read what the uninterrupted one's would.
+    virtual std::string save_state() const { return {}; }
+    virtual void restore_state(const std::string &state) {}
     // The policy's effective options (for the integrator's description) and its figures (map size and
     // build cost, roulette decisions...) for the statistics file.
     virtual nlohmann::json describe() const { return {{"policy", policy()}}; }
