@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # The whole test suite: installs what it needs (Debian packages, the Python venv with Mitsuba 3),
-# builds, then runs the C++ tests (ctest, then again under sanitizers), the fuzz targets for 30 s each,
+# builds, then runs the C++ tests (ctest, then again under ASan+UBSan, and the parallel parts under TSan),
+# the fuzz targets for 30 s each,
 # and the Python tests (pytest: CLI, comparison with Mitsuba 3).
 set -euo pipefail
 ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
@@ -15,5 +16,7 @@ ctest --test-dir "$ROOT/build" --output-on-failure -j2
 # The C++ tests again under AddressSanitizer + UndefinedBehaviorSanitizer (clang), then each fuzz target
 # of fuzz/ for 30 s: both in build-sanitize/.
 "$ROOT/scripts/test_sanitizers.sh"
+# ThreadSanitizer over the render loop's and the visibility map's tests, with TBB rebuilt for it.
+"$ROOT/scripts/test_tsan.sh"
 "$ROOT/scripts/fuzz.sh" 30
 cd "$ROOT" && NEEPP_BIN="$ROOT/build/neepp" "$ROOT/.venv/bin/python" -m pytest tests/python -q -rs
