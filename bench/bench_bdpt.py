@@ -24,7 +24,6 @@ REPO = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(REPO / "python"))
 sys.path.insert(0, str(REPO / "bench"))
 
-from bench_neepp import downsample  # noqa: E402
 from neepp_tools import REFERENCES, SCENES_DIR, credit, exr, machine, metrics, report, runner  # noqa: E402
 
 # name: (integrator, options)
@@ -64,7 +63,7 @@ def main(argv=None) -> int:
         W, H, _, ref_name = REFERENCES[scene]
         w, h = W // a.scale, H // a.scale
         xml = Path(a.scenes_dir) / scene / "scene.xml"
-        ref = downsample(exr.read_exr(Path(a.scenes_dir) / scene / "reference" / ref_name), a.scale)
+        ref = metrics.downsample(exr.read_exr(Path(a.scenes_dir) / scene / "reference" / ref_name), a.scale)
         rows, images = [], {}
         for m in methods:
             integrator, options = METHODS[m]

@@ -25,19 +25,12 @@ import json
 import sys
 from pathlib import Path
 
-import numpy as np
-
 REPO = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(REPO / "python"))
 
 from neepp_tools import REFERENCES, SCENES_DIR, credit, exr, machine, metrics, report, runner  # noqa: E402
 
 POLICIES = ["nee", "neepp", "neepp-adaptive", "neepp-cv"]
-
-
-def downsample(img: np.ndarray, f: int) -> np.ndarray:
-    h, w = img.shape[0] // f, img.shape[1] // f
-    return img[: h * f, : w * f].reshape(h, f, w, f, 3).mean(axis=(1, 3))
 
 
 def render(scene_xml, out, policy, *, spp=None, time_s=None, w, h, max_depth, seed, threads, options):
@@ -110,7 +103,7 @@ def main(argv=None) -> int:
         W, H, _, ref_name = REFERENCES[scene]
         w, h = W // a.scale, H // a.scale
         xml = Path(a.scenes_dir) / scene / "scene.xml"
-        ref = downsample(exr.read_exr(Path(a.scenes_dir) / scene / "reference" / ref_name), a.scale)
+        ref = metrics.downsample(exr.read_exr(Path(a.scenes_dir) / scene / "reference" / ref_name), a.scale)
         md.append(f"\n## {scene} ({w}x{h}, box filter; reference: Mitsuba 3 {ref_name} box-downsampled ×{a.scale})\n")
         if credit(scene):
             md.append(f"_{credit(scene)}_\n")

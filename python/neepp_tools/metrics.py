@@ -21,6 +21,14 @@ def _pair(img, ref):
     return a, r
 
 
+def downsample(img, f: int) -> np.ndarray:
+    """Box-downsample (H, W, 3) by an integer factor f (a render at 1/f the resolution with the box filter
+    estimates this image of the full-resolution reference)."""
+    img = np.asarray(img)
+    h, w = img.shape[0] // f, img.shape[1] // f
+    return img[: h * f, : w * f].reshape(h, f, w, f, 3).mean(axis=(1, 3))
+
+
 def relmse_map(img, ref, eps: float = EPS) -> np.ndarray:
     """Per-pixel relMSE averaged over channels, shape (H, W)."""
     a, r = _pair(img, ref)

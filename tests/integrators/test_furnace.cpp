@@ -102,4 +102,29 @@ TEST(Furnace, DiffuseSphereUnderConstantEnvironment) {
     }
 }
 
+// The sky the camera sees directly is the environment's radiance in every integrator, light tracing
+// included (no light path can reach a pinhole from the sky: its camera ray has to find it).
+TEST(Furnace, ConstantEnvironmentSeenDirectly) {
+    const std::string xml = R"(<scene version="3.0.0">
+  <sensor type="perspective">
+    <float name="fov" value="60"/>
+    <transform name="to_world"><lookat origin="0,0,-10" target="0,0,0" up="0,1,0"/></transform>
+    <film type="hdrfilm"><integer name="width" value="16"/><integer name="height" value="16"/><rfilter type="box"/></film>
+  </sensor>
+  <shape type="sphere"><float name="radius" value="1"/><bsdf type="diffuse"/></shape>
+  <emitter type="constant"><rgb name="radiance" value="0.25, 0.5, 2"/></emitter>
+</scene>)";
+    for (const char *integrator : {"path", "bdpt", "light"}) {
+        auto out = render_scene_file(write_temp_scene(xml), 4, 3, Options(OptionMap{{"max_depth", "3"}}), integrator);
+        for (auto [x, y] : {std::pair{0, 0}, {15, 0}, {0, 15}, {15, 15}, {7, 0}})  // corners and an edge: sky only
+            for (int c = 0; c < 3; ++c)
+                EXPECT_NEAR(out.image.at(x, y, c), c == 0 ? 0.25f : c == 1 ? 0.5f : 2.f, 1e-5f)
+                    << integrator << " pixel " << x << "," << y << " channel " << c;
+        // With hide_emitters the sky is black, in light tracing as in the others.
+        auto hidden = render_scene_file(write_temp_scene(xml), 1, 3,
+                                        Options(OptionMap{{"max_depth", "3"}, {"hide_emitters", "true"}}), integrator);
+        EXPECT_EQ(hidden.image.at(0, 0, 2), 0.f) << integrator;
+    }
+}
+
 }  // namespace

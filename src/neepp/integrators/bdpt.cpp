@@ -323,6 +323,19 @@ uint64_t BDPTIntegrator::begin_pass(const Scene &scene, const PassInfo &pass, Sp
     return M;
 }
 
+Color BDPTIntegrator::visible_environment(const Scene &scene, const Ray &ray, RenderCounters &counters) const {
+    // No light path can reach a pinhole from the sky it sees, so light tracing alone leaves the sky black
+    // where the camera sees it. The camera ray finds it (strategy s = 0, t = 2, which no light path
+    // samples for an infinite light: nothing is counted twice). Mitsuba's ptracer splats it instead.
+    if (options_.hide_emitters || options_.max_depth == 0 || scene.infinite_lights().empty()) return Color(0.f);
+    SurfaceInteraction si;
+    ++counters.rays;
+    if (scene.intersect(ray, si)) return Color(0.f);
+    Color Le(0.f);
+    for (const Light *env : scene.infinite_lights()) Le += env->eval_environment(ray.d);
+    return Le;
+}
+
 Color BDPTIntegrator::Li(const Scene &, const Ray &, Sampler &, RenderCounters &) const {
     throw std::logic_error("bdpt: renders through Li_splat (its t = 1 strategies splat onto the film)");
 }
@@ -333,7 +346,7 @@ Color BDPTIntegrator::Li_splat(const Scene &scene, const Ray &ray, Sampler &samp
     if (options_.light_tracer) {
         light_subpath(ctx_, light_walk_, sampler, light, counters);
         splat_light_path(light, sampler, counters, splats, 1.f);
-        return Color(0.f);
+        return visible_environment(scene, ray, counters);
     }
     camera_subpath(ctx_, ray, camera_walk_, sampler, camera, counters);
     Color L(0.f);

@@ -70,6 +70,8 @@ public:
     ShadowRayTester &shadow_rays() { return *shadow_; }
 
 private:
+    // Light tracing's only camera-side term: the infinite lights the camera ray sees directly.
+    Color visible_environment(const Scene &scene, const Ray &ray, RenderCounters &counters) const;
     // Contribution of strategy (s, t), MIS weight and visibility included; raster receives where a t = 1
     // strategy lands on the film.
     Color connect(const std::vector<PathVertex> &light, const std::vector<PathVertex> &camera, int s, int t,
