@@ -21,6 +21,10 @@ constexpr int kMaxUnboundedVertices = 64;
 // NEE++ selection: share of the uniform choice mixed into the visibility-driven one, so that a
 // candidate the map wrongly believes hidden keeps a probability of at least 0.1 / K.
 constexpr float kUniformMix = 0.1f;
+// Vertices of each side a candidate's score looks at: each pair is a visibility-map read (a cache miss,
+// the map being tens of MB), and deep vertices carry little throughput. All of them (up to 17 x 17 pairs
+// per candidate) doubled a sample's time on bathroom and veach-ajar for K = 4.
+constexpr int kScoreVertices = 3;
 // Pool paths' sampler: its own seed, so that pool paths and camera samples never share numbers.
 constexpr uint64_t kPoolSeed = 0x706f6f6c6c696768ULL;
 
@@ -245,39 +249,52 @@ void BDPTIntegrator::splat_light_path(const std::vector<PathVertex> &light, Samp
     }
 }
 
-const std::vector<PathVertex> *BDPTIntegrator::choose_light_path(const std::vector<PathVertex> &camera,
-                                                                 Sampler &sampler, float &weight) const {
+const std::vector<PathVertex> &BDPTIntegrator::choose_light_path(const std::vector<PathVertex> &camera,
+                                                                 const std::vector<PathVertex> &own, Sampler &sampler,
+                                                                 float &weight) const {
     const size_t M = pool_.size();
-    if (M == 0) return nullptr;
-    const int K = options_.candidates;
+    const int K = M == 0 ? 1 : options_.candidates;
+    weight = 1.f;
+    if (K == 1) return own;
     const VoxelGrid &grid = *shadow_->voxel_grid();
     const VisibilityMap &map = *shadow_->visibility_map();
     // The camera vertices a connection can start from (t >= 2), with their cells and throughputs.
     uint32_t cells[kMaxUnboundedVertices + 2];
     float lum[kMaxUnboundedVertices + 2];
     int n = 0;
-    for (size_t i = 1; i < camera.size(); ++i)
+    for (size_t i = 1; i < camera.size() && n < kScoreVertices; ++i)
         if (camera[i].connectible()) {
             cells[n] = grid.voxel_of(camera[i].p);
             lum[n++] = luminance(camera[i].beta);
         }
-    uint32_t chosen[64];
-    float score[64], total = 0;
-    for (int k = 0; k < K; ++k) {
-        chosen[k] = uint32_t(std::min<size_t>(size_t(sampler.next_1d() * float(M)), M - 1));
-        const std::vector<PathVertex> &y = pool_[chosen[k]];
-        const std::vector<uint32_t> &ycells = pool_cells_[chosen[k]];
+    // Σ over connectible vertex pairs of Ṽ(camera vertex, light vertex) × both throughputs' luminance,
+    // over the first kScoreVertices of each side.
+    auto score_of = [&](const std::vector<PathVertex> &y, auto &&cell_of) {
         float sc = 0;
-        for (size_t j = 1; j < y.size(); ++j) {
+        for (size_t j = 1, used = 0; j < y.size() && used < size_t(kScoreVertices); ++j) {
             if (!y[j].connectible()) continue;
+            ++used;
+            const uint32_t cj = cell_of(j);
             float sj = 0;
             for (int i = 0; i < n; ++i) {
-                const PairCounts c = map.counts(cells[i], ycells[j]);
+                const PairCounts c = map.counts(cells[i], cj);
                 sj += lum[i] * (c.traced ? VisibilityMap::estimate(c) : 1.f);
             }
             sc += sj * luminance(y[j].beta);
         }
-        score[k] = std::isfinite(sc) ? sc : 0.f;
+        return std::isfinite(sc) ? sc : 0.f;
+    };
+    // Candidate 0 is the camera sample's own light subpath, the others are drawn from the pool: all are
+    // independent draws of a light subpath, so (1/K) Σ_k CONNECT(X, Y_k) estimates the same as CONNECT(X, Y),
+    // and choosing one Y_k with probability p_k, weighted by 1 / (K p_k), estimates that.
+    uint32_t chosen[64];
+    float score[64], total = 0;
+    score[0] = score_of(own, [&](size_t j) { return own[j].infinite ? 0u : grid.voxel_of(own[j].p); });
+    total += score[0];
+    for (int k = 1; k < K; ++k) {
+        chosen[k] = uint32_t(std::min<size_t>(size_t(sampler.next_1d() * float(M)), M - 1));
+        const std::vector<uint32_t> &ycells = pool_cells_[chosen[k]];
+        score[k] = score_of(pool_[chosen[k]], [&](size_t j) { return ycells[j]; });
         total += score[k];
     }
     const float u = sampler.next_1d();
@@ -294,7 +311,7 @@ const std::vector<PathVertex> *BDPTIntegrator::choose_light_path(const std::vect
         }
     }
     weight = 1.f / (float(K) * p);
-    return &pool_[chosen[pick]];
+    return pick == 0 ? own : pool_[chosen[pick]];
 }
 
 uint64_t BDPTIntegrator::begin_pass(const Scene &scene, const PassInfo &pass, SplatFilm &splats,
@@ -349,36 +366,32 @@ Color BDPTIntegrator::Li_splat(const Scene &scene, const Ray &ray, Sampler &samp
         return visible_environment(scene, ray, counters);
     }
     camera_subpath(ctx_, ray, camera_walk_, sampler, camera, counters);
+    light_subpath(ctx_, light_walk_, sampler, light, counters);
     Color L(0.f);
-    const std::vector<PathVertex> *connect_to = &light;
+    // With NEE++ the s >= 2, t >= 2 connections go to the light subpath chosen among this one and K - 1
+    // from the pool (s = 0 and s = 1 need no light subpath: they keep this one, as t = 1 does).
     float selection_weight = 1.f;
-    if (options_.neepp_selection) {
-        // s = 0 and s = 1 need no light subpath; s >= 2, t >= 2 use the chosen pool path.
-        static const std::vector<PathVertex> none;
-        connect_to = choose_light_path(camera, sampler, selection_weight);
-        if (!connect_to) connect_to = &none;
-    } else {
-        light_subpath(ctx_, light_walk_, sampler, light, counters);
-    }
+    const std::vector<PathVertex> &chosen =
+        options_.neepp_selection ? choose_light_path(camera, light, sampler, selection_weight) : light;
     const int nc = int(camera.size());
     for (int t = 1; t <= nc; ++t) {
-        // Camera connections of the light path (t = 1): splatted; with NEE++ the pool's were already.
+        // Camera connections of the light path (t = 1): splatted.
         if (t == 1) {
-            if (!options_.neepp_selection) splat_light_path(light, sampler, counters, splats, 1.f);
+            splat_light_path(light, sampler, counters, splats, 1.f);
             continue;
         }
         if (wants(0, t)) {
             Vec2 unused;
-            L += connect(*connect_to, camera, 0, t, sampler, counters, unused);
+            L += connect(light, camera, 0, t, sampler, counters, unused);
         }
         if (wants(1, t)) {
             Vec2 unused;
-            L += connect(*connect_to, camera, 1, t, sampler, counters, unused);
+            L += connect(light, camera, 1, t, sampler, counters, unused);
         }
-        for (int s = 2; s <= int(connect_to->size()); ++s) {
+        for (int s = 2; s <= int(chosen.size()); ++s) {
             if (!wants(s, t)) continue;
             Vec2 unused;
-            L += connect(*connect_to, camera, s, t, sampler, counters, unused) * selection_weight;
+            L += connect(chosen, camera, s, t, sampler, counters, unused) * selection_weight;
         }
     }
     return L;
