@@ -34,6 +34,7 @@ METHODS = {
     "bdpt-neepp-k4": ("bdpt", {"light_paths": "neepp", "candidates": "4"}),
     "bdpt-neepp-k8": ("bdpt", {"light_paths": "neepp", "candidates": "8"}),
     "bdpt-neepp-k16": ("bdpt", {"light_paths": "neepp", "candidates": "16"}),
+    "bdpt-neepp-k4-frozen": ("bdpt", {"light_paths": "neepp", "candidates": "4", "learn": "false"}),
     "light": ("light", {}),
 }
 

@@ -38,7 +38,8 @@ def wait_for(path: Path, timeout: float):
 ])
 def test_a_stopped_render_resumes_to_the_uninterrupted_image(neepp_bin, tmp_path, integrator, spp, sig, options):
     ref, out = tmp_path / "ref.exr", tmp_path / "out.exr"
-    subprocess.run(args(neepp_bin, ref, spp, "--integrator", integrator, *options), check=True, timeout=300)
+    subprocess.run(args(neepp_bin, ref, spp, "--integrator", integrator, *options, "--stats", tmp_path / "ref.json"),
+                   check=True, timeout=300)
     checkpoint = Path(str(out) + ".checkpoint")
     p = subprocess.Popen(args(neepp_bin, out, spp, "--integrator", integrator, *options, "--checkpoint", 0.2,
                               "--stats", tmp_path / "first.json"))
@@ -56,6 +57,10 @@ def test_a_stopped_render_resumes_to_the_uninterrupted_image(neepp_bin, tmp_path
     if sig == signal.SIGTERM:  # stopped cleanly: its last checkpoint is where it stopped
         assert s["resumed_spp"] == json.loads((tmp_path / "first.json").read_text())["spp"]
     assert np.array_equal(read_exr(out), read_exr(ref))
+    # The counters continue too: a pass cut short by the stop is in neither the image nor the counts.
+    ref_stats = json.loads((tmp_path / "ref.json").read_text())
+    for key in ("rays", "shadow_rays", "light_rays", "splats"):
+        assert s[key] == ref_stats[key], key
     assert not checkpoint.exists()  # a finished render needs it no more
 
 

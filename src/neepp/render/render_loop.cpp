@@ -150,15 +150,20 @@ RenderResult render(const Scene &scene, Integrator &integrator, const RenderJob 
     };
     double last_checkpoint = elapsed();
     bool checkpointed_at_stop = false;
-    auto checkpoint = [&] {
+    auto counted = [&] {
+        RenderCounters sum = counters_before;
+        for (const RenderCounters &t : counters) sum += t;
+        return sum;
+    };
+    RenderCounters counted_at_pass_start;  // what a checkpoint of a pass cut short holds
+    auto checkpoint = [&](const RenderCounters &counted_so_far) {
         RenderCheckpoint c;
         c.spp = result.spp;
         c.passes = result.passes;
         c.render_time_s = elapsed();
         c.seconds_per_spp = seconds_per_spp;
         c.light_paths = light_paths;
-        c.counters = counters_before;
-        for (const RenderCounters &t : counters) c.counters += t;
+        c.counters = counted_so_far;
         c.image_sums = accumulated.sums();
         if (splatting) c.splat_sums = splats_accumulated->sums();
         c.integrator_state = integrator.save_state();
@@ -174,6 +179,7 @@ RenderResult render(const Scene &scene, Integrator &integrator, const RenderJob 
         if (size <= 0) { result.stopped_by = (job.spp > 0 && result.spp >= job.spp) ? "spp" : "time"; break; }
 
         const int s0 = result.spp;
+        if (job.on_checkpoint) counted_at_pass_start = counted();
         pass_block.clear();
         tiles_done = 0;
         pass_size_now = size;
@@ -253,7 +259,7 @@ RenderResult render(const Scene &scene, Integrator &integrator, const RenderJob 
         });
         if (aborted) {
             // A checkpoint holds whole passes: the one cut short is not in it (nor in a resumed image).
-            if (job.on_checkpoint && result.passes > 0) checkpoint();
+            if (job.on_checkpoint && result.passes > 0) checkpoint(counted_at_pass_start);
             checkpointed_at_stop = true;
             // Keep a partial first pass rather than nothing at all: every pixel it reached is unbiased.
             if (result.passes == 0) {
@@ -277,16 +283,15 @@ RenderResult render(const Scene &scene, Integrator &integrator, const RenderJob 
         ++result.passes;
         seconds_per_spp = (elapsed() - pass_start) / size;
         if (job.spp > 0 && result.spp >= job.spp) { result.stopped_by = "spp"; break; }
-        if (job.on_checkpoint && elapsed() - last_checkpoint >= job.checkpoint_interval_s) checkpoint();
+        if (job.on_checkpoint && elapsed() - last_checkpoint >= job.checkpoint_interval_s) checkpoint(counted());
     }
     // Stopped before its sample count between passes (time, Ctrl-C): what a resume continues from.
-    if (job.on_checkpoint && result.stopped_by != "spp" && !checkpointed_at_stop && result.passes > 0) checkpoint();
+    if (job.on_checkpoint && result.stopped_by != "spp" && !checkpointed_at_stop && result.passes > 0) checkpoint(counted());
     pass_size_now = 0;
     bar.finish();
 
     result.render_time_s = elapsed();
-    result.counters = counters_before;
-    for (const RenderCounters &c : counters) result.counters += c;
+    result.counters = counted();
     result.occlusion_time_s = double(result.counters.occlusion_ticks) * seconds_per_tick();
     result.image = current_image();
     return result;
