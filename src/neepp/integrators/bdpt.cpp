@@ -237,7 +237,7 @@ Color BDPTIntegrator::connect(const std::vector<PathVertex> &light, const std::v
 }
 
 void BDPTIntegrator::splat_light_path(const std::vector<PathVertex> &light, Sampler &sampler, RenderCounters &counters,
-                                      SplatFilm &splats, float scale) const {
+                                      SplatSink &splats, float scale) const {
     static const std::vector<PathVertex> no_camera(1);  // t = 1 reads camera[0] only through `sampled`
     for (int s = 1; s <= int(light.size()); ++s) {
         if (!wants(s, 1)) continue;
@@ -358,15 +358,21 @@ Color BDPTIntegrator::Li(const Scene &, const Ray &, Sampler &, RenderCounters &
 }
 
 Color BDPTIntegrator::Li_splat(const Scene &scene, const Ray &ray, Sampler &sampler, RenderCounters &counters,
-                               SplatFilm &splats) const {
+                               SplatSink &splats) const {
     thread_local std::vector<PathVertex> camera, light;
+    // Each part of the sample on its own stream (Sampler::use_stream): PSSMLT's mutations stay local.
     if (options_.light_tracer) {
+        sampler.use_stream(SampleStream::Light);
         light_subpath(ctx_, light_walk_, sampler, light, counters);
+        sampler.use_stream(SampleStream::Connection);
         splat_light_path(light, sampler, counters, splats, 1.f);
         return visible_environment(scene, ray, counters);
     }
+    sampler.use_stream(SampleStream::Camera);
     camera_subpath(ctx_, ray, camera_walk_, sampler, camera, counters);
+    sampler.use_stream(SampleStream::Light);
     light_subpath(ctx_, light_walk_, sampler, light, counters);
+    sampler.use_stream(SampleStream::Connection);
     Color L(0.f);
     // With NEE++ the s >= 2, t >= 2 connections go to the light subpath chosen among this one and K - 1
     // from the pool (s = 0 and s = 1 need no light subpath: they keep this one, as t = 1 does).

@@ -51,7 +51,7 @@ public:
     Color Li(const Scene &scene, const Ray &ray, Sampler &sampler, RenderCounters &counters) const override;
     bool splats() const override { return true; }
     Color Li_splat(const Scene &scene, const Ray &ray, Sampler &sampler, RenderCounters &counters,
-                   SplatFilm &splats) const override;
+                   SplatSink &splats) const override;
     uint64_t begin_pass(const Scene &scene, const PassInfo &pass, SplatFilm &splats, RenderCounters &counters) override;
     void end_pass(const Scene &scene, const PassStatistics &pass) override;
     bool learns_between_passes() const override { return shadow_->learns_between_passes(); }
@@ -80,7 +80,7 @@ private:
     bool wants(int s, int t) const;  // whether this render uses strategy (s, t)
     // Splats the t = 1 strategies of a light subpath (scaled by `scale`).
     void splat_light_path(const std::vector<PathVertex> &light, Sampler &sampler, RenderCounters &counters,
-                          SplatFilm &splats, float scale) const;
+                          SplatSink &splats, float scale) const;
     // NEE++: the light subpath the camera subpath's s >= 2 connections use, among its own and K - 1 from
     // the pool, and its weight 1 / (K p).
     const std::vector<PathVertex> &choose_light_path(const std::vector<PathVertex> &camera,

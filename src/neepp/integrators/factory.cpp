@@ -2,6 +2,7 @@
 #include <stdexcept>
 #include "neepp/integrators/bdpt.h"
 #include "neepp/integrators/path.h"
+#include "neepp/integrators/pssmlt.h"
 #include "neepp/light_selection/factory.h"
 #include "neepp/visibility/neepp_shadow_rays.h"
 
@@ -102,8 +103,34 @@ std::unique_ptr<Integrator> make_integrator(const std::string &name, const Optio
         integrator = std::make_unique<PathIntegrator>(o, std::move(shadow));
     } else if (name == "bdpt" || name == "light") {
         integrator = make_bdpt(name == "light", options);
+    } else if (name == "pssmlt") {
+        PSSMLTOptions o;
+        o.bidirectional = options.get_bool("bidirectional", o.bidirectional);
+        o.bootstrap = options.get_int("bootstrap", o.bootstrap);
+        o.chains = options.get_int("chains", o.chains);
+        o.large_step = options.get_float("large_step", o.large_step);
+        o.sigma = options.get_float("sigma", o.sigma);
+        if (o.bootstrap < 1) throw std::invalid_argument("bootstrap must be at least 1");
+        if (o.chains < 1) throw std::invalid_argument("chains must be at least 1");
+        if (!(o.large_step >= 0.f && o.large_step <= 1.f)) throw std::invalid_argument("large_step must be in [0, 1]");
+        if (!(o.sigma > 0.f && o.sigma <= 1.f)) throw std::invalid_argument("sigma must be in (0, 1]");
+        // The chain's target must be a function of its numbers, and never negative.
+        if (options.get_string("shadow_rays", "nee") == "neepp-cv")
+            throw std::invalid_argument("pssmlt: shadow_rays=neepp-cv is refused: its estimate can be negative, and "
+                                        "a Markov chain needs a target that never is (use neepp or neepp-adaptive)");
+        if (o.bidirectional && options.get_string("light_paths", "independent") == "neepp")
+            throw std::invalid_argument("pssmlt: light_paths=neepp is refused: its pool of light subpaths is traced anew "
+                                        "every pass, so a sample would not be a function of the chain's numbers");
+        const std::string over = o.bidirectional ? "bdpt" : "path";
+        std::unique_ptr<Integrator> inner;
+        try {
+            inner = make_integrator(over, options);
+        } catch (const std::invalid_argument &e) {
+            throw std::invalid_argument("pssmlt (over " + over + "): " + e.what());
+        }
+        integrator = std::make_unique<PSSMLTIntegrator>(o, std::move(inner));
     } else {
-        throw std::invalid_argument("unknown integrator '" + name + "' (supported: path, bdpt, light)");
+        throw std::invalid_argument("unknown integrator '" + name + "' (supported: path, bdpt, light, pssmlt)");
     }
     if (auto unused = options.unused(); !unused.empty()) {
         std::string list;

@@ -2,7 +2,10 @@
 // threads, passes and time; integrators own the light transport and may keep state between passes
 // (NEE++ publishes its visibility map there).
 #pragma once
+#include <atomic>
+#include <functional>
 #include <memory>
+#include <stdexcept>
 #include <span>
 #include <string>
 #include <nlohmann/json.hpp>
@@ -16,6 +19,7 @@ namespace neepp {
 class Scene;
 class Sampler;
 class SplatFilm;
+class SplatSink;
 
 // What the render loop tells an integrator before a pass.
 struct PassInfo {
@@ -24,6 +28,12 @@ struct PassInfo {
     int size = 0;               // samples per pixel this pass adds
     uint64_t camera_samples = 0;  // pixels × size
     uint64_t seed = 0;
+};
+
+// What the render loop gives an integrator that renders its passes itself (Integrator::render_pass).
+struct PassControl {
+    std::function<bool()> stop;                // true once the pass must end (cancel, time overrun)
+    std::atomic<uint64_t> *samples_done = nullptr;  // samples completed this pass, for the progress bar
 };
 
 class Integrator {
@@ -44,7 +54,7 @@ public:
     // film, and adds the splats to the image scaled by pixels / light paths.
     virtual bool splats() const { return false; }
     virtual Color Li_splat(const Scene &scene, const Ray &ray, Sampler &sampler, RenderCounters &counters,
-                           SplatFilm &splats) const {
+                           SplatSink &splats) const {
         return Li(scene, ray, sampler, counters);
     }
     // Light paths whose camera connections each camera sample splats (1: its own light path; 0 when the
@@ -55,6 +65,18 @@ public:
     // `splats`, which count toward the splats' normalization.
     virtual uint64_t begin_pass(const Scene &scene, const PassInfo &pass, SplatFilm &splats, RenderCounters &counters) {
         return 0;
+    }
+    // Integrators that are not one path per pixel (PSSMLT) supply the pass body themselves: the render
+    // loop keeps the budget, passes, progress, cancellation, checkpoints and statistics, and calls
+    // render_pass in place of its tile loop (and of begin_pass). A pass is pass.camera_samples samples,
+    // every one splatted (splats() must say true); the body adds the samples it completes to
+    // control.samples_done as it goes (the progress bar reads it), and returns early once control.stop()
+    // says so. Returns how many samples it splatted: they count toward the splats' normalization as light
+    // paths do.
+    virtual bool renders_passes() const { return false; }
+    virtual uint64_t render_pass(const Scene &scene, const PassInfo &pass, SplatFilm &splats,
+                                 RenderCounters &counters, const PassControl &control) {
+        throw std::logic_error("this integrator renders through the render loop's tile loop");
     }
     // Called between passes, single-threaded, after all samples of the pass are in.
     virtual void end_pass(const Scene &scene, const PassStatistics &pass) {}

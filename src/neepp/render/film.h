@@ -36,18 +36,27 @@ private:
     float radius_, inv_radius_, stddev_, gauss_offset_ = 0;
 };
 
+// Where an integrator puts the contributions of a sample that land on other pixels than its own: the
+// pass's splat film, or a list the caller weighs first (PSSMLT). Returns false for a value that was not
+// added (not finite, or too large), which the caller counts as an invalid sample.
+class SplatSink {
+public:
+    virtual ~SplatSink() = default;
+    virtual bool add(float px, float py, const Color &L) = 0;
+};
+
 // Contributions that land anywhere on the film, not at the sample's own pixel: light paths connected to
 // the camera (light tracing, BDPT's t = 1 strategies). Each splat is spread over the pixels of the filter's
 // footprint with weights f / ∫f (pbrt's splat normalization: a splat adds its value, not a weighted
 // average), and the image is the sums times a scale the caller knows (pixels / light paths). Sums are
 // fixed point (2^-32 steps, int64) and added atomically: integer addition does not depend on the order,
 // so the image is the same to the bit whichever thread splatted what, and any thread may splat anywhere.
-class SplatFilm {
+class SplatFilm final : public SplatSink {
 public:
     SplatFilm(int width, int height, const ReconstructionFilter *filter);
     // Thread-safe. Non-finite values, and values too large for the fixed point, are not added: returns
     // false for them (the caller counts them as invalid samples).
-    bool add(float px, float py, const Color &L);
+    bool add(float px, float py, const Color &L) override;
     // Adds another film's sums (same size).
     void merge(const SplatFilm &other);
     void clear();

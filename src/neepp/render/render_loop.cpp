@@ -113,11 +113,11 @@ RenderResult render(const Scene &scene, Integrator &integrator, const RenderJob 
     auto elapsed = [&] { return time_before + std::chrono::duration<double>(Clock::now() - start).count(); };
 
     std::vector<double> tile_m2(tiles.size());  // Σ lum(L)² per tile this pass, summed in tile order
-    std::atomic<int> tiles_done{0};
+    std::atomic<uint64_t> samples_done{0};  // camera samples completed this pass
     std::atomic<int> pass_size_now{0}, spp_done_now{0};
     auto fraction = [&]() -> double {
         if (timed && job.spp <= 0) return elapsed() / job.time_limit_s;
-        double spp_done = spp_done_now.load() + double(pass_size_now.load()) * tiles_done.load() / double(tiles.size());
+        double spp_done = spp_done_now.load() + double(samples_done.load()) / (double(W) * H);
         double f = spp_done / double(job.spp);
         return timed ? std::max(f, elapsed() / job.time_limit_s) : f;
     };
@@ -147,6 +147,10 @@ RenderResult render(const Scene &scene, Integrator &integrator, const RenderJob 
             for (size_t i = 0; i < image.data.size(); ++i) image.data[i] += splat.data[i];
         }
         return image;
+    };
+    // Light paths the pass's camera samples splatted (an integrator's own pass body counts its own).
+    auto camera_sample_light_paths = [&] {
+        return integrator.renders_passes() ? 0.0 : integrator.light_paths_per_sample() * double(samples_done);
     };
     double last_checkpoint = elapsed();
     bool checkpointed_at_stop = false;
@@ -181,18 +185,31 @@ RenderResult render(const Scene &scene, Integrator &integrator, const RenderJob 
         const int s0 = result.spp;
         if (job.on_checkpoint) counted_at_pass_start = counted();
         pass_block.clear();
-        tiles_done = 0;
+        samples_done = 0;
         pass_size_now = size;
         std::atomic<bool> aborted{false};
-        std::atomic<uint64_t> samples_done{0};  // camera samples of the tiles completed this pass
+        // A time limit cuts a pass short only when it overruns badly (the first pass, whose speed was
+        // unknown, or a wrong estimate): otherwise the pass, sized to fit, is finished.
+        auto must_stop = [&] {
+            const bool overrun = timed && (result.passes == 0 ? elapsed() > job.time_limit_s
+                                                              : elapsed() > 1.25 * job.time_limit_s);
+            if ((job.cancel && job.cancel->load()) || overrun) aborted = true;
+            return aborted.load(std::memory_order_relaxed);
+        };
         const double pass_start = elapsed();
-        uint64_t pass_light_paths = 0;  // traced before the pass (BDPT's NEE++ pool), splatted already
+        // Light paths splatted apart from the camera samples (BDPT's NEE++ pool before the pass) or the
+        // samples of an integrator's own pass body.
+        uint64_t pass_light_paths = 0;
+        const PassInfo info{result.passes, s0, size, uint64_t(W) * H * size, job.seed};
         if (splatting) {
             splats_pass->clear();
-            const PassInfo info{result.passes, s0, size, uint64_t(W) * H * size, job.seed};
-            arena.execute([&] { pass_light_paths = integrator.begin_pass(scene, info, *splats_pass, counters.local()); });
+            if (!integrator.renders_passes())
+                arena.execute([&] { pass_light_paths = integrator.begin_pass(scene, info, *splats_pass, counters.local()); });
         }
-        arena.execute([&] {
+        if (integrator.renders_passes()) {
+            const PassControl control{must_stop, &samples_done};
+            arena.execute([&] { pass_light_paths = integrator.render_pass(scene, info, *splats_pass, counters.local(), control); });
+        } else arena.execute([&] {
             tbb::parallel_for(tbb::blocked_range<size_t>(0, tiles.size(), 1), [&](const tbb::blocked_range<size_t> &r) {
                 const DenormalsAreZero ftz;
                 // Samples go to the integrator in batches (see Integrator::Li_batch), each with its own sampler.
@@ -204,15 +221,7 @@ RenderResult render(const Scene &scene, Integrator &integrator, const RenderJob 
                 std::vector<Color> radiance(kBatch);
                 RenderCounters &c = counters.local();
                 for (size_t ti = r.begin(); ti != r.end(); ++ti) {
-                    if (aborted.load(std::memory_order_relaxed)) return;
-                    // A time limit cuts a pass short only when it overruns badly (the first pass, whose speed
-                    // was unknown, or a wrong estimate): otherwise the pass, sized to fit, is finished.
-                    const bool overrun = timed && (result.passes == 0 ? elapsed() > job.time_limit_s
-                                                                      : elapsed() > 1.25 * job.time_limit_s);
-                    if ((job.cancel && job.cancel->load()) || overrun) {
-                        aborted = true;
-                        return;
-                    }
+                    if (aborted.load(std::memory_order_relaxed) || must_stop()) return;
                     const Tile &t = tiles[ti];
                     double m2 = 0;
                     ImageBlock block(t.x0 - border, t.y0 - border, t.w + 2 * border, t.h + 2 * border, &filter);
@@ -253,7 +262,6 @@ RenderResult render(const Scene &scene, Integrator &integrator, const RenderJob 
                     samples_done += uint64_t(t.w) * t.h * size;
                     std::lock_guard<std::mutex> lock(merge_mutex);
                     pass_block.merge(block);
-                    ++tiles_done;
                 }
             });
         });
@@ -266,7 +274,7 @@ RenderResult render(const Scene &scene, Integrator &integrator, const RenderJob 
                 accumulated.merge(pass_block);
                 if (splatting) {
                     splats_accumulated->merge(*splats_pass);
-                    light_paths += double(pass_light_paths) + integrator.light_paths_per_sample() * double(samples_done);
+                    light_paths += double(pass_light_paths) + camera_sample_light_paths();
                 }
             }
             result.stopped_by = (job.cancel && job.cancel->load()) ? "cancel" : "time";
@@ -275,7 +283,7 @@ RenderResult render(const Scene &scene, Integrator &integrator, const RenderJob 
         accumulated.merge(pass_block);
         if (splatting) {
             splats_accumulated->merge(*splats_pass);
-            light_paths += double(pass_light_paths) + integrator.light_paths_per_sample() * double(samples_done);
+            light_paths += double(pass_light_paths) + camera_sample_light_paths();
         }
         result.spp += size;
         spp_done_now = result.spp;

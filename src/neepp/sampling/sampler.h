@@ -9,6 +9,10 @@
 
 namespace neepp {
 
+// The parts of a path that read their numbers from a stream of their own where a sampler keeps streams.
+enum class SampleStream : uint8_t { Camera, Light, Connection, Roulette };
+constexpr int kSampleStreams = 4;
+
 class Sampler {
 public:
     virtual ~Sampler() = default;
@@ -17,6 +21,25 @@ public:
     virtual Vec2 next_2d() = 0;
     virtual std::unique_ptr<Sampler> clone() const = 0;
     virtual std::string name() const = 0;
+    // Switches the numbers that follow to another stream (each stream continues where it left off) and
+    // returns the one that was current. A sampler that mutates a path's numbers (PSSMLT's) keeps one
+    // sequence per part of the path, so that a part that draws more or fewer numbers (a longer camera
+    // subpath, a roulette taken or not) does not shift the numbers of the others; samplers with one
+    // sequence ignore it.
+    virtual SampleStream use_stream(SampleStream stream) { return stream; }
+};
+
+// Reads from `stream` for the scope's lifetime, then back to the stream that was current.
+class StreamScope {
+public:
+    StreamScope(Sampler &sampler, SampleStream stream) : sampler_(sampler), previous_(sampler.use_stream(stream)) {}
+    ~StreamScope() { sampler_.use_stream(previous_); }
+    StreamScope(const StreamScope &) = delete;
+    StreamScope &operator=(const StreamScope &) = delete;
+
+private:
+    Sampler &sampler_;
+    SampleStream previous_;
 };
 
 // Independent uniform random numbers (Mitsuba's `independent`).

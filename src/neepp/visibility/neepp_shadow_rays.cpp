@@ -112,7 +112,12 @@ ShadowTest NeeppShadowRays::begin_test(const ShadowQuery &q, Sampler &sampler, R
         return test;  // q = 1: every policy's weight reduces to V
     }
     const bool cv = options_.policy == ShadowRayPolicy::NeeppCV;
-    if (sampler.next_1d() < prob) {
+    float u;
+    {  // on a stream of its own, so that taking a roulette or not shifts none of the path's numbers
+        const StreamScope roulette(sampler, SampleStream::Roulette);
+        u = sampler.next_1d();
+    }
+    if (u < prob) {
         ++ts.roulette_traced;
         test.if_visible = cv ? v + (1.f - v) / prob : 1.f / prob;
         test.if_occluded = cv ? v - v / prob : 0.f;
