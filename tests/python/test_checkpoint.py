@@ -35,6 +35,8 @@ def wait_for(path: Path, timeout: float):
     ("bdpt", 40, signal.SIGKILL, []),
     ("path", 300, signal.SIGTERM, []),
     ("path", 200, signal.SIGKILL, ["-I", "shadow_rays=neepp-adaptive"]),  # the map and the calibration resume
+    ("pssmlt", 40, signal.SIGKILL, []),  # the chains resume where the last complete pass left them
+    ("pssmlt", 40, signal.SIGTERM, ["-I", "shadow_rays=neepp"]),  # a pass cut short: its mutations are undone
 ])
 def test_a_stopped_render_resumes_to_the_uninterrupted_image(neepp_bin, tmp_path, integrator, spp, sig, options):
     ref, out = tmp_path / "ref.exr", tmp_path / "out.exr"

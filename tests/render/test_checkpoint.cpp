@@ -1,7 +1,10 @@
 // Checkpoints: a render stopped at a pass boundary and resumed from its checkpoint reaches the same
 // sums, to the bit, as one that never stopped; checkpoint files round-trip and refuse damage.
 #include <gtest/gtest.h>
+#include <atomic>
+#include <chrono>
 #include <fstream>
+#include <thread>
 #include <vector>
 #include "common/temp_dir.h"
 #include "neepp/render/checkpoint.h"
@@ -73,6 +76,53 @@ TEST(Checkpoint, VisibilityAwareLightSelectionResumesToTheSameImage) {
 
 TEST(Checkpoint, BdptWithNeeppSelectionResumesToTheSameImage) {
     expect_resume_is_exact("bdpt", {{"light_paths", "neepp"}}, 6, 9);
+}
+
+// PSSMLT's chains are its state: they resume where the last complete pass left them. With NEE++ the
+// map too, which the chains' states are evaluated again under.
+TEST(Checkpoint, PssmltResumesToTheSameImage) {
+    expect_resume_is_exact("pssmlt", {{"chains", "16"}, {"bootstrap", "2000"}}, 6, 9);
+    expect_resume_is_exact("pssmlt", {{"chains", "16"}, {"bootstrap", "2000"}, {"shadow_rays", "neepp"}}, 6, 9);
+}
+
+// A pass cut short (Ctrl-C) has moved the chains on: its checkpoint holds them as the pass found them.
+TEST(Checkpoint, PssmltPassCutShortIsNotInItsCheckpoint) {
+    auto scene = project_scene("door-ajar");
+    Options options(scene->settings.integrator_options);
+    options.set("chains", "16");
+    options.set("bootstrap", "2000");
+    RenderJob job;
+    job.spp = 1000;  // never reached: cancelled first
+    job.seed = 3;
+    job.threads = 1;
+    std::vector<RenderCheckpoint> saved;
+    std::atomic<bool> cancel{false};
+    RenderJob part = job;
+    part.checkpoint_interval_s = 1e-9;
+    part.cancel = &cancel;
+    // Cancelled from inside a pass after the fourth: a chain checks between its mutations.
+    std::thread canceller;
+    part.on_checkpoint = [&](const RenderCheckpoint &c, const Image &) {
+        saved.push_back(c);
+        if (saved.size() == 4)
+            canceller = std::thread([&] { std::this_thread::sleep_for(std::chrono::milliseconds(30)); cancel = true; });
+    };
+    auto first = make_integrator("pssmlt", options);
+    const RenderResult stopped = render(*scene, *first, part);
+    canceller.join();
+    ASSERT_EQ(stopped.stopped_by, "cancel");
+    ASSERT_GE(saved.size(), 5u);
+    const RenderCheckpoint &last = saved.back();  // taken at the stop, of the passes completed
+    RenderJob whole = job;
+    whole.spp = last.spp + 8;
+    auto reference = make_integrator("pssmlt", options);
+    const RenderResult ref = render(*scene, *reference, whole);
+    RenderJob resume = whole;
+    resume.resume = &last;
+    auto resumed = make_integrator("pssmlt", options);
+    const RenderResult r = render(*scene, *resumed, resume);
+    EXPECT_EQ(r.image.data, ref.image.data) << "resumed from " << last.spp << " spp";
+    EXPECT_EQ(r.counters.rays, ref.counters.rays);
 }
 
 TEST(Checkpoint, FilesRoundTripAndRefuseDamage) {

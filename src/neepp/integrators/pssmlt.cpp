@@ -6,6 +6,7 @@
 #include <tbb/blocked_range.h>
 #include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
+#include "neepp/io/binary_io.h"
 #include "neepp/math/distribution.h"
 #include "neepp/render/film.h"
 #include "neepp/scene/scene.h"
@@ -125,6 +126,8 @@ bool PSSMLTIntegrator::bootstrap(const Scene &scene, const PassInfo &pass, Rende
 
 uint64_t PSSMLTIntegrator::render_pass(const Scene &scene, const PassInfo &pass, SplatFilm &splats,
                                        RenderCounters &counters, const PassControl &control) {
+    if (bootstrapped_) chains_at_pass_start_ = encode_chains();
+    in_pass_ = bootstrapped_;
     if (!bootstrapped_ && !bootstrap(scene, pass, counters, control)) return 0;
     const uint64_t total = pass.camera_samples;
     if (b_ <= 0) {  // no sample found light: the image is black, every mutation would record nothing
@@ -183,6 +186,48 @@ void PSSMLTIntegrator::end_pass(const Scene &scene, const PassStatistics &pass) 
     const bool learning = inner_->learns_between_passes();
     inner_->end_pass(scene, pass);
     map_changed_ = map_changed_ || learning;
+    in_pass_ = false;
+}
+
+std::string PSSMLTIntegrator::encode_chains() const {
+    BinaryWriter out;
+    out.put(uint8_t(bootstrapped_)), out.put(uint8_t(map_changed_)), out.put(b_);
+    out.put(mutations_), out.put(accepted_), out.put(large_steps_), out.put(large_accepted_), out.put(zero_proposals_);
+    out.put(uint64_t(chains_.size()));
+    for (const Chain &c : chains_) {
+        c.sampler.save(out);
+        out.put(c.f);
+        out.put_vector(c.current);
+    }
+    return out.bytes;
+}
+
+std::string PSSMLTIntegrator::save_state() const {
+    BinaryWriter out;
+    out.put_string(inner_->save_state());
+    out.put_string(in_pass_ ? chains_at_pass_start_ : encode_chains());
+    return out.bytes;
+}
+
+void PSSMLTIntegrator::restore_state(const Scene &scene, const std::string &state) {
+    BinaryReader in{state, 0, "pssmlt checkpoint state"};
+    inner_->restore_state(scene, in.get_string());
+    const std::string chains = in.get_string();
+    BinaryReader c{chains, 0, "pssmlt checkpoint state"};
+    bootstrapped_ = c.get<uint8_t>() != 0, map_changed_ = c.get<uint8_t>() != 0, b_ = c.get<double>();
+    mutations_ = c.get<uint64_t>(), accepted_ = c.get<uint64_t>(), large_steps_ = c.get<uint64_t>();
+    large_accepted_ = c.get<uint64_t>(), zero_proposals_ = c.get<uint64_t>();
+    const uint64_t n = c.get<uint64_t>();
+    if (bootstrapped_ && n != uint64_t(options_.chains))
+        throw std::runtime_error("pssmlt checkpoint state: it holds " + std::to_string(n) + " chains, not " +
+                                 std::to_string(options_.chains));
+    chains_.assign(size_t(n), Chain{PrimarySampleSpaceSampler(options_.sigma, options_.large_step), {}, 0});
+    for (Chain &chain : chains_) {
+        chain.sampler.load(c);
+        chain.f = c.get<float>();
+        chain.current = c.get_vector<Contribution>();
+    }
+    in_pass_ = false;
 }
 
 nlohmann::json PSSMLTIntegrator::describe() const {

@@ -45,6 +45,9 @@ public:
                          const PassControl &control) override;
     void end_pass(const Scene &scene, const PassStatistics &pass) override;
     bool learns_between_passes() const override { return inner_->learns_between_passes(); }
+    // The chains (as the last complete pass left them), b and the inner integrator's state.
+    std::string save_state() const override;
+    void restore_state(const Scene &scene, const std::string &state) override;
     nlohmann::json describe() const override;
     nlohmann::json statistics() const override;
 
@@ -68,9 +71,15 @@ private:
     // Estimates b and starts the chains; false when stopped before it finished.
     bool bootstrap(const Scene &scene, const PassInfo &pass, RenderCounters &counters, const PassControl &control);
 
+    std::string encode_chains() const;
+
     PSSMLTOptions options_;
     std::unique_ptr<Integrator> inner_;
     std::vector<Chain> chains_;
+    // The chains as the pass under way found them: a pass cut short is not in a checkpoint (the render
+    // loop keeps whole passes), so neither are its mutations.
+    std::string chains_at_pass_start_;
+    bool in_pass_ = false;
     bool bootstrapped_ = false;
     bool map_changed_ = false;  // the inner integrator learned since the chains' states were evaluated
     double b_ = 0;

@@ -98,6 +98,23 @@ Vec2 PrimarySampleSpaceSampler::next_2d() {
     return {a, next_1d()};
 }
 
+void PrimarySampleSpaceSampler::save(BinaryWriter &out) const {
+    if (proposing_) throw std::logic_error("PrimarySampleSpaceSampler: cannot save while a proposal is pending");
+    out.put_vector(x_);
+    out.put(iteration_), out.put(last_large_step_);
+    out.put(key_), out.put(proposals_), out.put(large_key_);
+    out.put(rng_.state()), out.put(rng_.increment());
+}
+
+void PrimarySampleSpaceSampler::load(BinaryReader &in) {
+    x_ = in.get_vector<Entry>();
+    iteration_ = in.get<int64_t>(), last_large_step_ = in.get<int64_t>();
+    key_ = in.get<uint64_t>(), proposals_ = in.get<uint64_t>(), large_key_ = in.get<uint64_t>();
+    const uint64_t state = in.get<uint64_t>(), inc = in.get<uint64_t>();
+    rng_.set_state(state, inc);
+    proposing_ = large_step_ = false;
+}
+
 std::unique_ptr<Sampler> PrimarySampleSpaceSampler::clone() const {
     return std::make_unique<PrimarySampleSpaceSampler>(*this);
 }

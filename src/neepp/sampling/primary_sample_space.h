@@ -11,6 +11,7 @@
 #include <cstdint>
 #include <string>
 #include <vector>
+#include "neepp/io/binary_io.h"
 #include "neepp/sampling/rng.h"
 #include "neepp/sampling/sampler.h"
 
@@ -42,6 +43,10 @@ public:
     SampleStream use_stream(SampleStream stream) override;
     std::unique_ptr<Sampler> clone() const override;
     std::string name() const override { return "primary_sample_space"; }
+
+    // The chain's whole state (entries, iteration, generator), for checkpoints; between proposals only.
+    void save(BinaryWriter &out) const;
+    void load(BinaryReader &in);
 
     uint64_t iteration() const { return iteration_; }
     size_t entries() const { return x_.size(); }

@@ -31,6 +31,10 @@ public:
     // Uniform float in [0, 1): 24 random mantissa bits.
     float next_float() { return float(next_u32() >> 8) * 0x1p-24f; }
     Vec2 next_2d() { float a = next_float(); return {a, next_float()}; }
+    // The whole state, for checkpoints: set_state(state(), increment()) continues the same sequence.
+    uint64_t state() const { return state_; }
+    uint64_t increment() const { return inc_; }
+    void set_state(uint64_t state, uint64_t increment) { state_ = state, inc_ = increment; }
 
 private:
     uint64_t state_, inc_;
