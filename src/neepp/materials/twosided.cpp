@@ -1,5 +1,7 @@
 #include "neepp/materials/twosided.h"
 
+#include <cmath>
+
 namespace neepp {
 namespace {
 Vec3 flip_z(Vec3 v) { return {v.x, v.y, -v.z}; }
@@ -82,11 +84,26 @@ SurfaceInteraction BumpMapBSDF::perturbed(const SurfaceInteraction &si, const Ve
     return p;
 }
 
+namespace {
+
+// Importance transport corrects for shading normals (Veach's thesis §5.3) with the frame of the hit,
+// si.sh_frame (the integrator does: path_vertex.cpp); a bump map's BSDF has the perturbed normal as its
+// shading normal, so the rest of the correction, from one normal to the other, is applied here:
+// |wi·nb| |wo·ns| / (|wo·nb| |wi·ns|), with ns = z of si's frame and nb = z of the perturbed one. Without it
+// light tracing and BDPT render a bump-mapped surface brighter or darker than path tracing does.
+float importance_correction(const BSDFContext &ctx, const Vec3 &wi, const Vec3 &wo, const Vec3 &wi_p, const Vec3 &wo_p) {
+    if (ctx.mode != TransportMode::Importance) return 1.f;
+    const float den = std::abs(wo_p.z * wi.z);
+    return den > 0 ? std::abs(wi_p.z * wo.z) / den : 0.f;
+}
+
+}  // namespace
+
 Color BumpMapBSDF::eval(const BSDFContext &ctx, const SurfaceInteraction &si, const Vec3 &wi, const Vec3 &wo) const {
     Vec3 wi_p;
     SurfaceInteraction p = perturbed(si, wi, wi_p);
     Vec3 wo_p = p.to_local(si.to_world(wo));
-    return nested_->eval(ctx, p, wi_p, wo_p);
+    return nested_->eval(ctx, p, wi_p, wo_p) * importance_correction(ctx, wi, wo, wi_p, wo_p);
 }
 
 float BumpMapBSDF::pdf(const BSDFContext &ctx, const SurfaceInteraction &si, const Vec3 &wi, const Vec3 &wo) const {
@@ -99,7 +116,10 @@ BSDFEval BumpMapBSDF::eval_pdf(const BSDFContext &ctx, const SurfaceInteraction 
                                const Vec3 &wo) const {
     Vec3 wi_p;
     SurfaceInteraction p = perturbed(si, wi, wi_p);  // once for both (a texture gradient lookup)
-    return nested_->eval_pdf(ctx, p, wi_p, p.to_local(si.to_world(wo)));
+    const Vec3 wo_p = p.to_local(si.to_world(wo));
+    BSDFEval e = nested_->eval_pdf(ctx, p, wi_p, wo_p);
+    e.f *= importance_correction(ctx, wi, wo, wi_p, wo_p);
+    return e;
 }
 
 BSDFSample BumpMapBSDF::sample(const BSDFContext &ctx, const SurfaceInteraction &si, const Vec3 &wi, float u1,
@@ -107,7 +127,9 @@ BSDFSample BumpMapBSDF::sample(const BSDFContext &ctx, const SurfaceInteraction 
     Vec3 wi_p;
     SurfaceInteraction p = perturbed(si, wi, wi_p);
     BSDFSample bs = nested_->sample(ctx, p, wi_p, u1, u2);
+    const Vec3 wo_p = bs.wo;
     bs.wo = si.to_local(p.to_world(bs.wo));
+    bs.weight *= importance_correction(ctx, wi, bs.wo, wi_p, wo_p);
     return bs;
 }
 
