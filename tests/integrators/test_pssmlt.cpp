@@ -43,9 +43,10 @@ TEST(PSSMLT, AgreesWithPathTracingWithNeeppRouletteInTheChain) {
                       "pssmlt over bdpt, NEE++ roulette");
 }
 
-TEST(PSSMLT, ImageMeanIsTheBootstrapsNormalization) {
-    // Every mutation records contributions whose luminance adds up to b: the image's mean luminance is
-    // b, so the bootstrap alone decides the image's brightness (box filter: nothing leaves the film).
+TEST(PSSMLT, ImageMeanIsTheNormalization) {
+    // Every mutation records contributions whose luminance adds up to one, scaled by b: the image's mean
+    // luminance is b, the mean of f over the bootstrap and the large steps (box filter: nothing leaves
+    // the film).
     const std::string path = write_temp_scene(kGlossyRoomXml);
     auto scene = load_scene(path);
     Options o(mlt());

@@ -74,6 +74,9 @@ public:
     // says so. Returns how many samples it splatted: they count toward the splats' normalization as light
     // paths do.
     virtual bool renders_passes() const { return false; }
+    // A factor on the splat layer that the integrator learns as the render goes (PSSMLT's normalization,
+    // refined by every pass), read whenever the image is formed.
+    virtual double splat_scale() const { return 1.0; }
     virtual uint64_t render_pass(const Scene &scene, const PassInfo &pass, SplatFilm &splats,
                                  RenderCounters &counters, const PassControl &control) {
         throw std::logic_error("this integrator renders through the render loop's tile loop");

@@ -51,7 +51,8 @@ void PSSMLTIntegrator::prepare(const Scene &scene) {
     inner_->prepare(scene);
     chains_.clear();
     bootstrapped_ = map_changed_ = false;
-    b_ = 0;
+    b_ = f_sum_ = pass_f_sum_ = 0;
+    f_samples_ = pass_f_samples_ = 0;
     mutations_ = accepted_ = large_steps_ = large_accepted_ = zero_proposals_ = 0;
 }
 
@@ -100,6 +101,7 @@ bool PSSMLTIntegrator::bootstrap(const Scene &scene, const PassInfo &pass, Rende
     if (stopped) return false;
     double sum = 0;  // in index order: the same b for any thread count
     for (float v : f) sum += v;
+    f_sum_ = sum, f_samples_ = N;
     b_ = sum / double(N);
     chains_.assign(size_t(options_.chains), Chain{PrimarySampleSpaceSampler(options_.sigma, options_.large_step), {}, 0});
     if (b_ > 0) {
@@ -137,6 +139,7 @@ uint64_t PSSMLTIntegrator::render_pass(const Scene &scene, const PassInfo &pass,
     const size_t n = chains_.size();
     tbb::enumerable_thread_specific<RenderCounters> local;
     std::atomic<uint64_t> recorded{0}, accepted{0}, large{0}, large_accepted{0}, zero{0};
+    std::vector<double> large_f(n, 0.0);  // per chain, summed in chain order: the same for any thread count
     const bool reevaluate = map_changed_;
     tbb::parallel_for(tbb::blocked_range<size_t>(0, n, 1), [&](const tbb::blocked_range<size_t> &r) {
         RenderCounters &rc = local.local();
@@ -154,8 +157,9 @@ uint64_t PSSMLTIntegrator::render_pass(const Scene &scene, const PassInfo &pass,
                     const bool large_step = chain.sampler.propose();
                     const float f = evaluate(scene, chain.sampler, proposal, rc);
                     const float a = chain.f > 0 ? std::min(1.f, f / chain.f) : 1.f;
-                    if (a > 0 && f > 0) record(splats, proposal, float(double(a) * b_ / double(f)));
-                    if (a < 1 && chain.f > 0) record(splats, chain.current, float(double(1.f - a) * b_ / double(chain.f)));
+                    if (a > 0 && f > 0) record(splats, proposal, a / f);
+                    if (a < 1 && chain.f > 0) record(splats, chain.current, (1.f - a) / chain.f);
+                    if (large_step) large_f[k] += double(f);  // an independent sample of f: refines b
                     lg += large_step;
                     z += !(f > 0);
                     if (chain.sampler.uniform() < a) {
@@ -178,6 +182,9 @@ uint64_t PSSMLTIntegrator::render_pass(const Scene &scene, const PassInfo &pass,
     map_changed_ = false;
     mutations_ += recorded, accepted_ += accepted, large_steps_ += large, large_accepted_ += large_accepted;
     zero_proposals_ += zero;
+    pass_f_sum_ = 0;
+    for (double v : large_f) pass_f_sum_ += v;
+    pass_f_samples_ = large;
     return recorded;
 }
 
@@ -187,11 +194,16 @@ void PSSMLTIntegrator::end_pass(const Scene &scene, const PassStatistics &pass) 
     inner_->end_pass(scene, pass);
     map_changed_ = map_changed_ || learning;
     in_pass_ = false;
+    // The pass's large steps join b's estimate once the pass is in the image (one cut short is not).
+    f_sum_ += pass_f_sum_, f_samples_ += pass_f_samples_;
+    pass_f_sum_ = 0, pass_f_samples_ = 0;
+    if (f_samples_ > 0) b_ = f_sum_ / double(f_samples_);
 }
 
 std::string PSSMLTIntegrator::encode_chains() const {
     BinaryWriter out;
     out.put(uint8_t(bootstrapped_)), out.put(uint8_t(map_changed_)), out.put(b_);
+    out.put(f_sum_), out.put(f_samples_);
     out.put(mutations_), out.put(accepted_), out.put(large_steps_), out.put(large_accepted_), out.put(zero_proposals_);
     out.put(uint64_t(chains_.size()));
     for (const Chain &c : chains_) {
@@ -215,6 +227,7 @@ void PSSMLTIntegrator::restore_state(const Scene &scene, const std::string &stat
     const std::string chains = in.get_string();
     BinaryReader c{chains, 0, "pssmlt checkpoint state"};
     bootstrapped_ = c.get<uint8_t>() != 0, map_changed_ = c.get<uint8_t>() != 0, b_ = c.get<double>();
+    f_sum_ = c.get<double>(), f_samples_ = c.get<uint64_t>();
     mutations_ = c.get<uint64_t>(), accepted_ = c.get<uint64_t>(), large_steps_ = c.get<uint64_t>();
     large_accepted_ = c.get<uint64_t>(), zero_proposals_ = c.get<uint64_t>();
     const uint64_t n = c.get<uint64_t>();
@@ -242,6 +255,7 @@ nlohmann::json PSSMLTIntegrator::describe() const {
 
 nlohmann::json PSSMLTIntegrator::statistics() const {
     nlohmann::json j = {{"normalization", b_},
+                        {"normalization_samples", f_samples_},
                         {"mutations", mutations_},
                         {"acceptance", mutations_ ? double(accepted_) / double(mutations_) : 0.0},
                         {"large_steps", large_steps_},

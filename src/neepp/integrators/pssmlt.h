@@ -10,8 +10,10 @@
 // (every number afresh) with probability large_step and small ones (normal offsets of size sigma)
 // otherwise, accepted with probability a = min(1, f(u') / f(u)). Each mutation records both states,
 // the proposal weighted by a and the current one by 1 - a (Veach's expected-value recording), each
-// contribution scaled by b / f: the image is pixels · b · E[c / f] over the chain, so a sample's splat,
-// as a light path's, is normalized by pixels / samples. `--spp` counts mutations per pixel.
+// contribution divided by f: the image is pixels · b · E[c / f] over the chain, so a sample's splat,
+// as a light path's, is normalized by pixels / samples, and the splat layer is scaled by b. A large
+// step's proposal is an independent uniform sample: its f refines b (Kelemen et al. §4), so the image's
+// brightness does not stay at the bootstrap's error. `--spp` counts mutations per pixel.
 //
 // NEE++'s shadow-ray policies work inside the chain: a roulette's number is part of u, on its stream, so
 // the 1/q weights are part of f. When the visibility map changes between passes, f changes with it:
@@ -61,6 +63,8 @@ public:
     float evaluate(const Scene &scene, PrimarySampleSpaceSampler &sampler, std::vector<Contribution> &out,
                    RenderCounters &counters) const;
     double normalization() const { return b_; }  // b, once the bootstrap has run
+    // The splats are c / f: the image is them times b, whose estimate improves as the render goes.
+    double splat_scale() const override { return b_; }
 
 private:
     struct Chain {
@@ -82,7 +86,10 @@ private:
     bool in_pass_ = false;
     bool bootstrapped_ = false;
     bool map_changed_ = false;  // the inner integrator learned since the chains' states were evaluated
-    double b_ = 0;
+    // b: the mean of f over the bootstrap and every large step of the completed passes (each an
+    // independent uniform sample of u), so the image's brightness converges as its noise does.
+    double b_ = 0, f_sum_ = 0, pass_f_sum_ = 0;
+    uint64_t f_samples_ = 0, pass_f_samples_ = 0;
     uint64_t mutations_ = 0, accepted_ = 0, large_steps_ = 0, large_accepted_ = 0, zero_proposals_ = 0;
 };
 

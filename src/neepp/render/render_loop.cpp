@@ -143,7 +143,7 @@ RenderResult render(const Scene &scene, Integrator &integrator, const RenderJob 
     auto current_image = [&] {
         Image image = accumulated.resolve();
         if (splatting && light_paths > 0) {
-            const Image splat = splats_accumulated->resolve(double(W) * H / light_paths);
+            const Image splat = splats_accumulated->resolve(double(W) * H / light_paths * integrator.splat_scale());
             for (size_t i = 0; i < image.data.size(); ++i) image.data[i] += splat.data[i];
         }
         return image;
