@@ -41,7 +41,7 @@ std::pair<std::string, std::string> split_key_value(const std::string &s, const 
 }
 
 struct RenderArgs {
-    std::string scene, output = "render.exr", integrator, stats, sampler, rfilter, visibility_map;
+    std::string scene, output = "render.exr", integrator, stats, sampler, rfilter, visibility_map, snapshots;
     int spp = 0, threads = 0;
     double time_s = 0, checkpoint_s = 0;
     bool resume = false;
@@ -158,6 +158,18 @@ Rendered run_render(const RenderArgs &a) {
             neepp::write_render_images(a.output, image);
         };
     }
+    // --snapshots DIR: the image at geometrically spaced times, for convergence plots (neepp compare).
+    nlohmann::json snapshot_index = nlohmann::json::array();
+    auto write_snapshot = [&](int spp, double time_s, const neepp::Image &image) {
+        const std::string file = fmt::format("snapshot_{:03d}.exr", snapshot_index.size());
+        neepp::write_exr(a.snapshots + "/" + file, image);
+        snapshot_index.push_back({{"file", file}, {"spp", spp}, {"render_time_s", time_s}});
+        neepp::write_file_atomically(a.snapshots + "/snapshots.json", snapshot_index.dump(1) + "\n");
+    };
+    if (!a.snapshots.empty()) {
+        check_output_path(a.snapshots + "/snapshots.json", "snapshot folder", nullptr);
+        job.on_snapshot = write_snapshot;
+    }
     if (!a.quiet)
         fmt::print(stderr, "neepp: {} ({}x{}, {} triangles, {} lights, loaded in {:.2f} s), integrator {}, {}\n",
                    a.scene, scene->camera.width, scene->camera.height, scene->triangle_count(), scene->lights().size(),
@@ -166,6 +178,10 @@ Rendered run_render(const RenderArgs &a) {
 
     neepp::RenderResult result = neepp::render(*scene, *integrator, job);
     std::string png = neepp::write_render_images(a.output, result.image);
+    // The last snapshot is the final image (unless the last pass just took it).
+    if (!a.snapshots.empty() && result.spp > 0 &&
+        (snapshot_index.empty() || snapshot_index.back()["spp"].get<int>() != result.spp))
+        write_snapshot(result.spp, result.render_time_s, result.image);
     if ((a.resume || a.checkpoint_s > 0) && result.stopped_by == "spp") std::filesystem::remove(checkpoint_path);
     nlohmann::json stats = neepp::render_statistics(*scene, *integrator, result, job);
     stats["load_time_s"] = load_s;
@@ -299,13 +315,18 @@ int main(int argc, char **argv) {
     render->add_option("-I", ra.integrator_options,
                        "Integrator option key=value; path: max_depth, rr_depth, hide_emitters, nee, light_sampler (" +
                            samplers + "), shadow_rays (nee, neepp, neepp-adaptive, neepp-cv), voxels, samples_per_pair, "
-                           "q_min, learn, learn_until, min_occluded, adaptive_target, shadow_ray_cost (see README)");
+                           "q_min, learn, learn_until, min_occluded, adaptive_target, shadow_ray_cost; bdpt: mis, strategy, "
+                           "strategy_weight, light_paths, candidates, pool; pssmlt: bidirectional, bootstrap, chains, "
+                           "large_step, sigma (see README)");
     render->add_option("--sampler", ra.sampler, "Sampler: independent or sobol (default: the scene's)");
     render->add_option("--rfilter", ra.rfilter, "Override the film's reconstruction filter")
         ->check(CLI::IsMember({"box", "tent", "gaussian"}));
     render->add_option("--visibility-map", ra.visibility_map,
                        "NEE++ visibility map file: loaded if it exists and belongs to this scene, else built and saved");
     render->add_option("--stats", ra.stats, "Write statistics JSON here");
+    render->add_option("--snapshots", ra.snapshots,
+                       "Write the image so far into this folder at geometrically spaced times (snapshot_NNN.exr, "
+                       "listed in snapshots.json with their spp and render time), for convergence plots");
     render->add_option("--checkpoint", ra.checkpoint_s,
                        "Every this many seconds, and when stopped early, save the render's state to OUTPUT.checkpoint "
                        "and write the image so far")

@@ -152,7 +152,7 @@ RenderResult render(const Scene &scene, Integrator &integrator, const RenderJob 
     auto camera_sample_light_paths = [&] {
         return integrator.renders_passes() ? 0.0 : integrator.light_paths_per_sample() * double(samples_done);
     };
-    double last_checkpoint = elapsed();
+    double last_checkpoint = elapsed(), last_snapshot = 0;
     bool checkpointed_at_stop = false;
     auto counted = [&] {
         RenderCounters sum = counters_before;
@@ -290,6 +290,10 @@ RenderResult render(const Scene &scene, Integrator &integrator, const RenderJob 
         integrator.end_pass(scene, pass_statistics(result.passes, result.spp, size, tile_m2, accumulated));
         ++result.passes;
         seconds_per_spp = (elapsed() - pass_start) / size;
+        if (job.on_snapshot && (last_snapshot == 0 || elapsed() >= job.snapshot_growth * last_snapshot)) {
+            last_snapshot = elapsed();
+            job.on_snapshot(result.spp, last_snapshot, current_image());
+        }
         if (job.spp > 0 && result.spp >= job.spp) { result.stopped_by = "spp"; break; }
         if (job.on_checkpoint && elapsed() - last_checkpoint >= job.checkpoint_interval_s) checkpoint(counted());
     }

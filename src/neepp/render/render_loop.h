@@ -31,6 +31,10 @@ struct RenderJob {
     double checkpoint_interval_s = 0;
     std::function<void(const RenderCheckpoint &, const Image &)> on_checkpoint;
     const RenderCheckpoint *resume = nullptr;
+    // Snapshots of the image as it converges (convergence plots): after the first pass, then after each
+    // pass that ends once the render time has grown snapshot_growth times since the last snapshot.
+    double snapshot_growth = 1.5;
+    std::function<void(int spp, double render_time_s, const Image &)> on_snapshot;
 };
 
 struct RenderResult {
