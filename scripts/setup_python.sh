@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Create the project's Python virtualenv (.venv, git-ignored) with the tools used by
-# python/neepp_tools, tests/python and bench/: numpy, pytest, matplotlib, pillow and Mitsuba 3
-# (the peer renderer). Also installs libllvm19 (Debian 12 main) for Mitsuba's llvm_ad_rgb
+# python/neepp_tools, tests/python and bench/: numpy, pytest, matplotlib, pillow, Mitsuba 3
+# (the peer renderer) and flip-evaluator (NVIDIA FLIP, for neepp compare). Also installs libllvm19 (Debian 12 main) for Mitsuba's llvm_ad_rgb
 # variant, which must then be run with DRJIT_LIBLLVM_PATH set (neepp_tools.runner does it).
 # Idempotent; safe to rerun. Usage: scripts/setup_python.sh [VENV_DIR]
 set -euo pipefail
@@ -17,6 +17,7 @@ REQS=(
   "matplotlib>=3.7"
   "pillow>=9"
   "mitsuba==3.9.*"
+  "flip-evaluator>=1.7"
 )
 
 # libllvm19 for the llvm variant (LLVM 14/15 make Dr.Jit abort). Skip apt when present.
@@ -36,14 +37,14 @@ fi
 if "$VENV/bin/python" - "${REQS[@]}" <<'PY' 2>/dev/null
 import sys
 from importlib.metadata import version
-want = {"numpy": None, "pytest": None, "matplotlib": None, "pillow": None, "mitsuba": "3.9."}
+want = {"numpy": None, "pytest": None, "matplotlib": None, "pillow": None, "mitsuba": "3.9.", "flip-evaluator": None}
 for name, prefix in want.items():
     v = version(name)
     if prefix and not v.startswith(prefix):
         sys.exit(1)
 PY
 then
-  echo "setup_python: $VENV already has numpy, pytest, matplotlib, pillow, mitsuba 3.9"
+  echo "setup_python: $VENV already has numpy, pytest, matplotlib, pillow, mitsuba 3.9, flip-evaluator"
 else
   "$VENV/bin/python" -m pip install -q --upgrade pip
   "$VENV/bin/python" -m pip install -q "${REQS[@]}"

@@ -5,8 +5,9 @@
 # and the Python tests (pytest: CLI, comparison with Mitsuba 3).
 set -euo pipefail
 ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
-# valgrind: tests/python/test_instructions.py runs bench/instructions.py, which counts instructions with it.
-"$ROOT/scripts/install_deps.sh" valgrind
+# valgrind: tests/python/test_instructions.py runs bench/instructions.py, which counts instructions with it;
+# chromium: tests/python/test_compare.py opens neepp compare's page in it (headless).
+"$ROOT/scripts/install_deps.sh" valgrind chromium
 "$ROOT/scripts/setup_python.sh"
 "$ROOT/scripts/build.sh"
 # The instruction-count test runs neepp under valgrind, which cannot run a -march=native build of an

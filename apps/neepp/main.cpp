@@ -1,7 +1,10 @@
 // The `neepp` command-line tool: render a Mitsuba 3 scene, or the built-in demo.
 #include <atomic>
 #include <chrono>
+#include <cerrno>
 #include <csignal>
+#include <cstdlib>
+#include <cstring>
 #include <filesystem>
 #include <iostream>
 #include <stdexcept>
@@ -293,6 +296,31 @@ void run_demo(const std::string &dir, int spp, bool quiet) {
     }
 }
 
+// `neepp compare` is neepp_tools.compare (Python: the metrics, NVIDIA FLIP, the plots and the page); this
+// runs it with the project's interpreter (NEEPP_PYTHON, else the checkout's .venv, else python3) and
+// tells it which neepp to render with. Does not return.
+[[noreturn]] void run_compare(const std::vector<std::string> &args) {
+    namespace fs = std::filesystem;
+    const char *env = std::getenv("NEEPP_PYTHON");
+    const std::string venv = std::string(NEEPP_SOURCE_DIR) + "/.venv/bin/python";
+    const std::string python = env && *env ? env : fs::exists(venv) ? venv : "python3";
+    const char *old_path = std::getenv("PYTHONPATH");
+    const std::string path = std::string(NEEPP_SOURCE_DIR) + "/python" + (old_path && *old_path ? std::string(":") + old_path : "");
+    setenv("PYTHONPATH", path.c_str(), 1);
+    std::error_code ec;
+    const fs::path self = fs::canonical("/proc/self/exe", ec);
+    std::vector<std::string> words = {python, "-m", "neepp_tools.compare"};
+    if (!ec) words.insert(words.end(), {"--neepp", self.string()});
+    words.insert(words.end(), args.begin(), args.end());
+    std::vector<char *> argv;
+    for (std::string &w : words) argv.push_back(w.data());
+    argv.push_back(nullptr);
+    execvp(argv[0], argv.data());
+    fmt::print(stderr, "neepp: error: cannot run {} for neepp compare: {} (scripts/setup_python.sh sets up its Python)\n",
+               python, std::strerror(errno));
+    std::exit(1);
+}
+
 }  // namespace
 
 int main(int argc, char **argv) {
@@ -345,7 +373,14 @@ int main(int argc, char **argv) {
     demo->add_option("--spp", demo_spp, "Samples per pixel")->check(CLI::Range(1, 1 << 20));
     demo->add_flag("-q,--quiet", demo_quiet, "No progress bar or messages");
 
+    auto *compare = app.add_subcommand("compare", "Render a scene with several methods at equal time (or spp) and "
+                                                  "write an HTML report: neepp compare SCENE.xml --methods path,bdpt,pssmlt "
+                                                  "--time S [--reference REF.exr] -o DIR (neepp compare --help for all)");
+    compare->prefix_command();  // everything after it is the Python tool's
+    compare->set_help_flag();
+
     CLI11_PARSE(app, argc, argv);
+    if (*compare) run_compare(compare->remaining());
     std::signal(SIGINT, on_stop_signal);
     std::signal(SIGTERM, on_stop_signal);
     try {

@@ -34,6 +34,9 @@ struct PassInfo {
 struct PassControl {
     std::function<bool()> stop;                // true once the pass must end (cancel, time overrun)
     std::atomic<uint64_t> *samples_done = nullptr;  // samples completed this pass, for the progress bar
+    // Seconds of the pass spent on one-off work (PSSMLT's bootstrap), which the body adds here: left out
+    // of the speed that sizes the passes after it.
+    double *one_off_s = nullptr;
 };
 
 class Integrator {

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <atomic>
+#include <chrono>
 #include <stdexcept>
 #include <tbb/blocked_range.h>
 #include <tbb/enumerable_thread_specific.h>
@@ -130,7 +131,12 @@ uint64_t PSSMLTIntegrator::render_pass(const Scene &scene, const PassInfo &pass,
                                        RenderCounters &counters, const PassControl &control) {
     if (bootstrapped_) chains_at_pass_start_ = encode_chains();
     in_pass_ = bootstrapped_;
-    if (!bootstrapped_ && !bootstrap(scene, pass, counters, control)) return 0;
+    if (!bootstrapped_) {
+        const auto start = std::chrono::steady_clock::now();
+        const bool done = bootstrap(scene, pass, counters, control);
+        if (control.one_off_s) *control.one_off_s += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+        if (!done) return 0;
+    }
     const uint64_t total = pass.camera_samples;
     if (b_ <= 0) {  // no sample found light: the image is black, every mutation would record nothing
         *control.samples_done += total;

@@ -200,6 +200,7 @@ RenderResult render(const Scene &scene, Integrator &integrator, const RenderJob 
         // Light paths splatted apart from the camera samples (BDPT's NEE++ pool before the pass) or the
         // samples of an integrator's own pass body.
         uint64_t pass_light_paths = 0;
+        double one_off_s = 0;
         const PassInfo info{result.passes, s0, size, uint64_t(W) * H * size, job.seed};
         if (splatting) {
             splats_pass->clear();
@@ -207,7 +208,7 @@ RenderResult render(const Scene &scene, Integrator &integrator, const RenderJob 
                 arena.execute([&] { pass_light_paths = integrator.begin_pass(scene, info, *splats_pass, counters.local()); });
         }
         if (integrator.renders_passes()) {
-            const PassControl control{must_stop, &samples_done};
+            const PassControl control{must_stop, &samples_done, &one_off_s};
             arena.execute([&] { pass_light_paths = integrator.render_pass(scene, info, *splats_pass, counters.local(), control); });
         } else arena.execute([&] {
             tbb::parallel_for(tbb::blocked_range<size_t>(0, tiles.size(), 1), [&](const tbb::blocked_range<size_t> &r) {
@@ -289,7 +290,7 @@ RenderResult render(const Scene &scene, Integrator &integrator, const RenderJob 
         spp_done_now = result.spp;
         integrator.end_pass(scene, pass_statistics(result.passes, result.spp, size, tile_m2, accumulated));
         ++result.passes;
-        seconds_per_spp = (elapsed() - pass_start) / size;
+        seconds_per_spp = std::max(elapsed() - pass_start - one_off_s, 0.0) / size;
         if (job.on_snapshot && (last_snapshot == 0 || elapsed() >= job.snapshot_growth * last_snapshot)) {
             last_snapshot = elapsed();
             job.on_snapshot(result.spp, last_snapshot, current_image());
