@@ -32,7 +32,7 @@ def wait_for(path: Path, timeout: float):
 
 @pytest.mark.parametrize("integrator, spp, sig, options", [
     ("path", 300, signal.SIGKILL, []),
-    ("bdpt", 40, signal.SIGKILL, []),
+    ("bdpt", 100, signal.SIGKILL, []),  # passes of 1, 32, 32, 32, 3 spp: the kill lands inside the third
     ("path", 300, signal.SIGTERM, []),
     ("path", 200, signal.SIGKILL, ["-I", "shadow_rays=neepp-adaptive"]),  # the map and the calibration resume
     ("pssmlt", 40, signal.SIGKILL, []),  # the chains resume where the last complete pass left them
