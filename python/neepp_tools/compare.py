@@ -29,7 +29,7 @@ from pathlib import Path
 
 import numpy as np
 
-from . import machine, metrics, runner
+from . import credit, machine, metrics, runner
 from .exr import read_exr, tonemap_srgb
 from .report import auto_exposure
 
@@ -131,7 +131,8 @@ def compute_results(args, methods, renders, ref) -> tuple[dict, dict]:
                "time_s": None if args.spp else args.time, "spp": args.spp, "seeds": args.seeds,
                "reference": str(args.reference) if args.reference else None,
                "width": int(first.shape[1]), "height": int(first.shape[0]), "exposure": exposure,
-               "machine": machine.describe(), "methods": []}
+               "machine": machine.describe(), "credit": credit(Path(args.scene).resolve().parent.name),
+               "methods": []}
     pictures = {}
     flip_missing = False
     for m in methods:
@@ -355,7 +356,8 @@ document.getElementById("title").textContent = document.title;
 document.getElementById("summary").textContent =
   `${R.mode}: ${R.spp ? R.spp + " spp" : R.time_s + " s"} per method, ${R.width}x${R.height}, ${R.seeds} seed(s); ` +
   `reference: ${R.reference || "none (no error metrics)"}; machine: ${R.machine.cpu || ""} ` +
-  `(${R.machine.cores || "?"} cores, ${R.machine.simd || ""})` + (R.note ? "; " + R.note : "");
+  `(${R.machine.cores || "?"} cores, ${R.machine.simd || ""})` + (R.note ? "; " + R.note : "") +
+  (R.credit ? ". Scene: " + R.credit : "");
 const COLS = [["label", "method"], ["relmse", "relMSE"], ["rel_variance", "relative variance"], ["mean_flip", "mean FLIP"],
   ["spp", "spp"], ["render_time_s", "time (s)"], ["rays", "rays"], ["shadow_rays", "shadow rays"],
   ["occlusion_time_s", "occlusion time (s)"], ["image_mean", "image mean"]];
