@@ -142,6 +142,15 @@ inline BlockMoments moments_over_seeds(const std::vector<std::vector<double>> &p
     return m;
 }
 
+// Block moments of one integrator over `seeds` renders of a scene file, seeded seed0 + 31 s.
+inline BlockMoments block_moments(const std::string &path, const std::string &integrator, const Options &o, int seeds,
+                                  int spp, uint64_t seed0) {
+    std::vector<std::vector<double>> per_seed;
+    for (int s = 0; s < seeds; ++s)
+        per_seed.push_back(block_means(render_scene_file(path, spp, seed0 + 31 * s, o, integrator).image, 6, 6));
+    return moments_over_seeds(per_seed);
+}
+
 // Two-sample z-tests per block (Bonferroni over ~12 blocks at a ~1e-3 family-wise level, with a generous
 // bound for the heavier tails of few-seed variance estimates) and on the whole-image mean.
 inline void expect_same_image(const BlockMoments &ref, const BlockMoments &test, const std::string &what) {

@@ -16,14 +16,6 @@ using namespace neepp::testing;
 
 namespace {
 
-BlockMoments block_moments(const std::string &path, const std::string &integrator, const Options &o, int seeds, int spp,
-                           uint64_t seed0) {
-    std::vector<std::vector<double>> per_seed;
-    for (int s = 0; s < seeds; ++s)
-        per_seed.push_back(block_means(render_scene_file(path, spp, seed0 + 31 * s, o, integrator).image, 6, 6));
-    return moments_over_seeds(per_seed);
-}
-
 TEST(BDPT, AgreesWithPathTracingOnAGlossyRoom) {
     const std::string path = write_temp_scene(kGlossyRoomXml);
     const BlockMoments ref = block_moments(path, "path", Options(), 6, 48, 100);
@@ -71,21 +63,26 @@ TEST(BDPT, EachUnweightedStrategyEstimatesDirectLight) {
     }
 }
 
-// A quad whose vertex normals lean away from its face normal, lit at a slant: shading normals make the
-// BSDF's adjoint differ from the BSDF (Veach §5.3). Light tracing without the correction renders it
-// visibly darker or brighter than path tracing (the bug of pbrt-v4 issues #13 and #385).
-std::string tilted_normals_scene() {
-    const std::string scene = write_temp_scene(R"(<scene version="3.0.0">
+// A surface seen from above and lit at a slant by a small sphere light, in a scene file of its own.
+std::string slanted_light_scene(const std::string &surface) {
+    return write_temp_scene(R"(<scene version="3.0.0">
   <sensor type="perspective">
     <float name="fov" value="50"/>
     <transform name="to_world"><lookat origin="0,2.2,2.2" target="0,0,0" up="0,1,0"/></transform>
     <film type="hdrfilm"><integer name="width" value="24"/><integer name="height" value="18"/><rfilter type="box"/></film>
   </sensor>
-  <shape type="obj"><string name="filename" value="quad.obj"/>
-    <bsdf type="roughplastic"><float name="alpha" value="0.4"/><rgb name="diffuse_reflectance" value="0.7"/></bsdf></shape>
+)" + surface + R"(
   <shape type="sphere"><point name="center" x="-2" y="1.2" z="-0.5"/><float name="radius" value="0.3"/>
     <emitter type="area"><rgb name="radiance" value="20"/></emitter></shape>
 </scene>)");
+}
+
+// A quad whose vertex normals lean away from its face normal: shading normals make the BSDF's adjoint
+// differ from the BSDF (Veach §5.3). Light tracing without the correction renders it visibly darker or
+// brighter than path tracing (the bug of pbrt-v4 issues #13 and #385).
+std::string tilted_normals_scene() {
+    const std::string scene = slanted_light_scene(R"(  <shape type="obj"><string name="filename" value="quad.obj"/>
+    <bsdf type="roughplastic"><float name="alpha" value="0.4"/><rgb name="diffuse_reflectance" value="0.7"/></bsdf></shape>)");
     std::ofstream(std::filesystem::path(scene).parent_path() / "quad.obj")
         << "v -1 0 -1\nv 1 0 -1\nv 1 0 1\nv -1 0 1\n"
            "vn -0.5 1 0\nvn 0.5 1 0.3\nvn 0.6 1 0\nvn -0.4 1 -0.5\n"
@@ -105,21 +102,12 @@ TEST(LightTracer, CorrectsForShadingNormals) {
 // and BDPT rendered such a block 9 % and 23 % brighter than path tracing before the bump map corrected
 // for it). A height field that rises along u, tilting the normal by ~45° over the whole plane.
 std::string bump_mapped_scene() {
-    const std::string scene = write_temp_scene(R"(<scene version="3.0.0">
-  <sensor type="perspective">
-    <float name="fov" value="50"/>
-    <transform name="to_world"><lookat origin="0,2.2,2.2" target="0,0,0" up="0,1,0"/></transform>
-    <film type="hdrfilm"><integer name="width" value="24"/><integer name="height" value="18"/><rfilter type="box"/></film>
-  </sensor>
-  <shape type="rectangle"><transform name="to_world"><rotate x="1" angle="-90"/></transform>
+    const std::string scene = slanted_light_scene(R"(  <shape type="rectangle"><transform name="to_world"><rotate x="1" angle="-90"/></transform>
     <bsdf type="bumpmap">
       <texture name="map" type="bitmap"><string name="filename" value="ramp.exr"/><boolean name="raw" value="true"/></texture>
       <float name="scale" value="2"/>
       <bsdf type="roughplastic"><float name="alpha" value="0.2"/><rgb name="diffuse_reflectance" value="0.6"/></bsdf>
-    </bsdf></shape>
-  <shape type="sphere"><point name="center" x="-2" y="1.2" z="-0.5"/><float name="radius" value="0.3"/>
-    <emitter type="area"><rgb name="radiance" value="20"/></emitter></shape>
-</scene>)");
+    </bsdf></shape>)");
     Image ramp(32, 32, 3);
     for (int y = 0; y < 32; ++y)
         for (int x = 0; x < 32; ++x)

@@ -19,14 +19,6 @@ OptionMap mlt(OptionMap extra = {}) {
     return extra;
 }
 
-BlockMoments block_moments(const std::string &path, const std::string &integrator, const Options &o, int seeds, int spp,
-                           uint64_t seed0) {
-    std::vector<std::vector<double>> per_seed;
-    for (int s = 0; s < seeds; ++s)
-        per_seed.push_back(block_means(render_scene_file(path, spp, seed0 + 31 * s, o, integrator).image, 6, 6));
-    return moments_over_seeds(per_seed);
-}
-
 TEST(PSSMLT, AgreesWithPathTracingOnAGlossyRoom) {
     const std::string path = write_temp_scene(kGlossyRoomXml);
     const BlockMoments ref = block_moments(path, "path", Options(), 6, 64, 100);
