@@ -21,7 +21,7 @@ struct CameraConnection {
 struct PerspectiveCamera {
     Transform to_world;
     int width = 768, height = 576;
-    float fov = 39.3077f;          // degrees, along fov_axis
+    float fov = 39.3077f;          // degrees, along fov_axis (the loader sets Mitsuba 3's default when a scene gives none)
     std::string fov_axis = "x";    // x, y, diagonal, smaller, larger
     float near_clip = 1e-2f, far_clip = 1e4f;
 
