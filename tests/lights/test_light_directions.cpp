@@ -497,13 +497,13 @@ TEST(EnvironmentMapLight, DirectionsAreUnitUnderAnyTransform) {
 }
 
 TEST(EnvironmentMapLight, TexelsSitOnMitsubasGrid) {
-    // Texel (i, j) is seen at u = i / W (wrapping) and v = j / (H - 1) (first and last rows on the
-    // poles); rows 0 and H-1 are skipped because u is undefined at the poles.
+    // Texel (i, j) is seen at u = (i + 1/2) / W (wrapping) and v = j / (H - 1) (first and last rows on
+    // the poles); rows 0 and H-1 are skipped because u is undefined at the poles.
     Image img = make_env_image();
     EnvironmentMapLight light(img, kEnvToWorld, kEnvScale);
     for (int j = 1; j < kEnvH - 1; ++j)
         for (int i = 0; i < kEnvW; ++i) {
-            Vec3 d = light.uv_to_direction({float(i) / kEnvW, float(j) / (kEnvH - 1)});
+            Vec3 d = light.uv_to_direction({(float(i) + 0.5f) / kEnvW, float(j) / (kEnvH - 1)});
             Color expected = img.rgb(i, j) * kEnvScale, got = light.eval_environment(d);
             EXPECT_TRUE(near_rel(got, expected, 1e-3f, 1e-4f))
                 << "texel " << i << "," << j << ": (" << got.x << "," << got.y << "," << got.z << ") vs ("
@@ -523,7 +523,7 @@ TEST(EnvironmentMapLight, LookupsBlendTheirFourTexels) {
         for (int j = 1; j < kEnvH - 2; ++j)
             for (int i = 0; i < kEnvW; ++i) {
                 const int i1 = (i + 1) % kEnvW;
-                const Vec3 d = light.uv_to_direction({(float(i) + fx) / kEnvW, (float(j) + fy) / (kEnvH - 1)});
+                const Vec3 d = light.uv_to_direction({(float(i) + 0.5f + fx) / kEnvW, (float(j) + fy) / (kEnvH - 1)});
                 const Color expected = img.rgb(i, j) * ((1 - fx) * (1 - fy)) + img.rgb(i1, j) * (fx * (1 - fy)) +
                                        img.rgb(i, j + 1) * ((1 - fx) * fy) + img.rgb(i1, j + 1) * (fx * fy);
                 const Color got = light.eval_environment(d);

@@ -143,17 +143,17 @@ Color EnvironmentMapLight::texel(size_t index) const {
     return Color(float_[i], float_[i + 1], float_[i + 2]);
 }
 
-// Bilinear lookup with Mitsuba's envmap convention: texel (i, j) sits at u = i / W (the map wraps
-// horizontally) and v = j / (H - 1) (the first and last rows lie on the poles).
+// Bilinear lookup with Mitsuba 3's envmap convention: texel (i, j) sits at u = (i + 1/2) / W (the map
+// wraps horizontally) and v = j / (H - 1) (the first and last rows lie on the poles).
 EnvironmentMapLight::Bilinear EnvironmentMapLight::bilinear(Vec2 uv) const {
     const int w = width_, h = height_;
-    float x = uv.x * float(w), y = uv.y * float(h - 1);
+    float x = uv.x * float(w) - 0.5f, y = uv.y * float(h - 1);
     int x0 = int(std::floor(x)), y0 = std::clamp(int(std::floor(y)), 0, h - 1);
     float fx = x - float(x0), fy = std::clamp(y - float(y0), 0.f, 1.f);
-    // u in [0, 1] puts x0 in [0, w]: one subtraction wraps it, without the two integer divisions of a
+    // u in [0, 1] puts x0 in [-1, w - 1]: one addition wraps it, without the two integer divisions of a
     // modulo (the general case, for u outside, keeps them).
-    if (x0 == w) x0 = 0;
-    else if (x0 < 0 || x0 > w) x0 = ((x0 % w) + w) % w;
+    if (x0 == -1) x0 = w - 1;
+    else if (x0 < 0 || x0 >= w) x0 = ((x0 % w) + w) % w;
     int x1 = x0 + 1 == w ? 0 : x0 + 1, y1 = std::min(y0 + 1, h - 1);
     const size_t r0 = size_t(y0) * w, r1 = size_t(y1) * w;
     return {r0 + x0, r0 + x1, r1 + x0, r1 + x1,
