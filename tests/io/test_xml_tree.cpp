@@ -241,6 +241,31 @@ TEST(XmlTree, IncludesFilesRelativeToTheIncludingFile) {
     EXPECT_EQ(shapes[0]->resolve_path("x.obj"), (tmp.dir / "x.obj").lexically_normal().string());
 }
 
+// <path value="..."/> adds a folder (relative to the file naming it) that files are looked for in first,
+// the last added first, then the scene's folder; Mitsuba 3's render suite uses it in 39 of its 41 scenes.
+TEST(XmlTree, PathElementsAddSearchFolders) {
+    TempDir tmp;
+    tmp.write("meshes/a.obj", "v 0 0 0\n");
+    tmp.write("more/a.obj", "v 0 0 0\n");
+    tmp.write("more/b.obj", "v 0 0 0\n");
+    tmp.write("c.obj", "v 0 0 0\n");
+    std::string path = tmp.write("s.xml", scene(R"(
+  <shape type="obj"><string name="filename" value="a.obj"/></shape>
+  <path value="more"/>
+  <path value="meshes"/>
+)"));
+    auto root = parse_mitsuba_xml(path);
+    auto shape = root->children_with_tag("shape").at(0);
+    // Declared after the shape, still searched (as in Mitsuba, which resolves files once the scene is read).
+    EXPECT_EQ(shape->resolve_path("a.obj"), (tmp.dir / "meshes/a.obj").lexically_normal().string());
+    EXPECT_EQ(shape->resolve_path("b.obj"), (tmp.dir / "more/b.obj").lexically_normal().string());
+    EXPECT_EQ(shape->resolve_path("c.obj"), (tmp.dir / "c.obj").lexically_normal().string());
+    // Found nowhere: the scene's folder, which the loader's "cannot open" message then names.
+    EXPECT_EQ(shape->resolve_path("d.obj"), (tmp.dir / "d.obj").lexically_normal().string());
+    EXPECT_THROW(parse_mitsuba_xml(tmp.write("bad.xml", scene(R"(<path value=""/>)"))), std::runtime_error);
+    EXPECT_THROW(parse_mitsuba_xml(tmp.write("bad2.xml", scene(R"(<path/>)"))), std::runtime_error);
+}
+
 TEST(XmlTree, ErrorsNameFileAndLine) {
     TempDir tmp;
     auto check = [&](const std::string &body, int line, const std::string &needle) {

@@ -150,7 +150,14 @@ std::vector<std::shared_ptr<XmlNode>> XmlNode::children_with_tag(const std::stri
 
 std::string XmlNode::resolve_path(const std::string &path) const {
     fs::path p(path);
-    if (p.is_absolute() || base_dir.empty()) return path;
+    if (p.is_absolute()) return path;
+    if (search_dirs)
+        for (auto it = search_dirs->rbegin(); it != search_dirs->rend(); ++it) {
+            std::error_code ec;
+            const fs::path candidate = (fs::path(*it) / p).lexically_normal();
+            if (fs::exists(candidate, ec)) return candidate.string();
+        }
+    if (base_dir.empty()) return path;
     return (fs::path(base_dir) / p).lexically_normal().string();
 }
 
@@ -256,6 +263,7 @@ private:
     std::vector<Param> params_;  // longest key first, so "$resx2" is not substituted as "$resx" + "2"
     std::map<std::string, std::shared_ptr<XmlNode>> ids_;
     std::string base_dir_;
+    std::shared_ptr<std::vector<std::string>> search_dirs_ = std::make_shared<std::vector<std::string>>();
 
     void add_param(const std::string &name, const std::string &value) {
         Param p{"$" + name, value};
@@ -364,6 +372,7 @@ private:
         node->file = src.path;
         node->line = src.line_of(el);
         node->base_dir = base_dir_;
+        node->search_dirs = search_dirs_;
         if (!node->id.empty()) {
             auto [it, inserted] = ids_.emplace(node->id, node);
             if (!inserted)
@@ -520,6 +529,15 @@ private:
             auto it = ids_.find(from);
             if (it == ids_.end()) fail(src, el, "<alias>: unknown id \"" + from + "\"");
             if (!ids_.emplace(to, it->second).second) fail(src, el, "<alias>: id \"" + to + "\" already exists");
+            return;
+        } else if (tag == "path") {
+            // A folder to look for files in, relative to the file that names it.
+            check_attributes(src, el, {"!value"});
+            reject_children(src, el);
+            fs::path dir(el.attribute("value").value());
+            if (dir.empty()) fail(src, el, "<path> needs a non-empty value");
+            if (!dir.is_absolute()) dir = fs::path(src.dir) / dir;
+            search_dirs_->push_back(fs::absolute(dir).lexically_normal().string());
             return;
         } else if (tag == "include") {
             check_attributes(src, el, {"!filename", "name"});

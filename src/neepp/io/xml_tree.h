@@ -36,6 +36,9 @@ struct XmlNode {
     std::string file;  // the XML file the element was read from, for messages
     int line = 0;
     std::string base_dir;  // directory that relative `filename` values are resolved against
+    // Folders the scene's <path value="..."/> elements add, searched first (the last added first), as
+    // Mitsuba's file resolver does; shared by every node of a scene and complete once it is parsed.
+    std::shared_ptr<const std::vector<std::string>> search_dirs;
     std::map<std::string, XmlProperty> props;
     // Nested objects in document order. A <ref> puts the referenced node itself here, so an object
     // used by many others is one shared node.
