@@ -28,6 +28,10 @@ private:
     BSDFPtr default_bsdf_;
 };
 
+// The scene's <integrator>: its type and options, with Mitsuba 3's integrators mapped to the one here
+// that renders the same image (prb, volpath without media, direct, ptracer, the moment wrapper), said
+// in one line on stderr.
+void load_integrator(const XmlNode &node, RenderSettings &settings);
 // Reports properties that no builder read (misspelt or unsupported) on stderr, as Mitsuba does.
 void warn_unused(const XmlNode &node);
 // An IOR given as a number or a name from Mitsuba's table ("bk7", "air"...).

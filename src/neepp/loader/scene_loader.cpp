@@ -9,16 +9,6 @@
 namespace neepp {
 namespace {
 
-std::string property_as_string(const XmlProperty &p) {
-    switch (p.kind) {
-    case XmlProperty::Kind::Integer: return std::to_string(p.i);
-    case XmlProperty::Kind::Float: return fmt::format("{}", p.f);
-    case XmlProperty::Kind::Boolean: return p.b ? "true" : "false";
-    case XmlProperty::Kind::String: return p.s;
-    default: return "";
-    }
-}
-
 void load_film(const XmlNode &film, Scene &scene) {
     if (film.type != "hdrfilm") throw film.error("unsupported film '" + film.type + "' (supported: hdrfilm)");
     scene.camera.width = film.get_int("width", 768);
@@ -111,13 +101,7 @@ std::unique_ptr<Scene> load_scene(const std::string &path, const std::map<std::s
             load_sensor(*node, *scene);
             have_sensor = true;
         } else if (tag == "integrator") {
-            scene->settings.integrator = node->type;
-            for (auto &[name, prop] : node->props) {
-                std::string v = property_as_string(prop);
-                if (v.empty()) throw node->error("integrator option '" + name + "' must be a number, boolean or string");
-                scene->settings.integrator_options[name] = v;
-                prop.used = true;
-            }
+            loader::load_integrator(*node, scene->settings);
         } else if (tag == "bsdf" || tag == "texture") {
             // Declared for later <ref>s; built when a shape uses them.
         } else {
