@@ -31,7 +31,7 @@ import numpy as np
 
 from . import credit, machine, metrics, runner
 from .exr import read_exr, tonemap_srgb
-from .report import auto_exposure
+from .report import auto_exposure, error_map_rgba
 
 ERR_RANGE = (1e-4, 1e1)
 
@@ -62,18 +62,6 @@ def _png_bytes(rgb01: np.ndarray) -> bytes:
     buf = BytesIO()
     Image.fromarray((np.clip(rgb01, 0, 1) * 255 + 0.5).astype(np.uint8)).save(buf, format="PNG")
     return buf.getvalue()
-
-
-def _error_map(img: np.ndarray, ref: np.ndarray) -> np.ndarray:
-    """False-colour (inferno, log scale over ERR_RANGE) per-pixel relMSE, as RGB in [0, 1]."""
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-    from matplotlib.colors import LogNorm
-
-    emap = np.maximum(metrics.relmse_map(img, ref), ERR_RANGE[0])
-    return plt.get_cmap("inferno")(LogNorm(vmin=ERR_RANGE[0], vmax=ERR_RANGE[1])(emap))[..., :3]
 
 
 def _flip(img: np.ndarray, ref: np.ndarray):
@@ -152,7 +140,7 @@ def compute_results(args, methods, renders, ref) -> tuple[dict, dict]:
         if ref is not None:
             row["relmse"] = metrics.relmse(r0.image, ref)
             row["relmse_seeds"] = [metrics.relmse(r.image, ref) for r, _, _ in runs]
-            pic["error"] = _error_map(r0.image, ref)
+            pic["error"] = error_map_rgba(r0.image, ref, ERR_RANGE)[..., :3]
             fmap, fmean = _flip(r0.image, ref)
             if fmap is None:
                 flip_missing = True

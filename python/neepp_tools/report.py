@@ -91,8 +91,8 @@ def comparison_figure(path, images: dict, ref: np.ndarray | None = None, title: 
     return scores
 
 
-def error_map_png(path, img: np.ndarray, ref: np.ndarray, err_range: tuple = (1e-4, 1e1)) -> None:
-    """A single false-colour (log) relMSE map as a PNG of the image's size."""
+def error_map_rgba(img: np.ndarray, ref: np.ndarray, err_range: tuple = (1e-4, 1e1)) -> np.ndarray:
+    """Per-pixel relMSE in false colour (inferno, log scale over err_range), RGBA in [0, 1]."""
     import matplotlib
 
     matplotlib.use("Agg")
@@ -100,9 +100,15 @@ def error_map_png(path, img: np.ndarray, ref: np.ndarray, err_range: tuple = (1e
     from matplotlib.colors import LogNorm
 
     emap = np.maximum(metrics.relmse_map(img, ref), err_range[0])
-    rgba = plt.get_cmap("inferno")(LogNorm(vmin=err_range[0], vmax=err_range[1])(emap))
+    return plt.get_cmap("inferno")(LogNorm(vmin=err_range[0], vmax=err_range[1])(emap))
+
+
+def error_map_png(path, img: np.ndarray, ref: np.ndarray, err_range: tuple = (1e-4, 1e1)) -> None:
+    """A single false-colour (log) relMSE map as a PNG of the image's size."""
+    import matplotlib.pyplot as plt
+
     Path(path).parent.mkdir(parents=True, exist_ok=True)
-    plt.imsave(str(path), rgba)
+    plt.imsave(str(path), error_map_rgba(img, ref, err_range))
 
 
 def _fmt(v) -> str:

@@ -52,7 +52,7 @@ void PSSMLTIntegrator::prepare(const Scene &scene) {
     inner_->prepare(scene);
     chains_.clear();
     bootstrapped_ = map_changed_ = false;
-    b_ = f_sum_ = pass_f_sum_ = 0;
+    f_sum_ = pass_f_sum_ = 0;
     f_samples_ = pass_f_samples_ = 0;
     mutations_ = accepted_ = large_steps_ = large_accepted_ = zero_proposals_ = 0;
 }
@@ -103,9 +103,8 @@ bool PSSMLTIntegrator::bootstrap(const Scene &scene, const PassInfo &pass, Rende
     double sum = 0;  // in index order: the same b for any thread count
     for (float v : f) sum += v;
     f_sum_ = sum, f_samples_ = N;
-    b_ = sum / double(N);
     chains_.assign(size_t(options_.chains), Chain{PrimarySampleSpaceSampler(options_.sigma, options_.large_step), {}, 0});
-    if (b_ > 0) {
+    if (normalization() > 0) {
         // Each chain starts from a bootstrap sample drawn in proportion to f, its numbers replayed, then
         // continues on numbers of its own (chains that start alike part at their first mutation).
         const Distribution1D pick(f);
@@ -138,7 +137,7 @@ uint64_t PSSMLTIntegrator::render_pass(const Scene &scene, const PassInfo &pass,
         if (!done) return 0;
     }
     const uint64_t total = pass.camera_samples;
-    if (b_ <= 0) {  // no sample found light: the image is black, every mutation would record nothing
+    if (!(normalization() > 0)) {  // no sample found light: the image is black, every mutation would record nothing
         *control.samples_done += total;
         return total;
     }
@@ -203,12 +202,11 @@ void PSSMLTIntegrator::end_pass(const Scene &scene, const PassStatistics &pass) 
     // The pass's large steps join b's estimate once the pass is in the image (one cut short is not).
     f_sum_ += pass_f_sum_, f_samples_ += pass_f_samples_;
     pass_f_sum_ = 0, pass_f_samples_ = 0;
-    if (f_samples_ > 0) b_ = f_sum_ / double(f_samples_);
 }
 
 std::string PSSMLTIntegrator::encode_chains() const {
     BinaryWriter out;
-    out.put(uint8_t(bootstrapped_)), out.put(uint8_t(map_changed_)), out.put(b_);
+    out.put(uint8_t(bootstrapped_)), out.put(uint8_t(map_changed_));
     out.put(f_sum_), out.put(f_samples_);
     out.put(mutations_), out.put(accepted_), out.put(large_steps_), out.put(large_accepted_), out.put(zero_proposals_);
     out.put(uint64_t(chains_.size()));
@@ -232,7 +230,7 @@ void PSSMLTIntegrator::restore_state(const Scene &scene, const std::string &stat
     inner_->restore_state(scene, in.get_string());
     const std::string chains = in.get_string();
     BinaryReader c{chains, 0, "pssmlt checkpoint state"};
-    bootstrapped_ = c.get<uint8_t>() != 0, map_changed_ = c.get<uint8_t>() != 0, b_ = c.get<double>();
+    bootstrapped_ = c.get<uint8_t>() != 0, map_changed_ = c.get<uint8_t>() != 0;
     f_sum_ = c.get<double>(), f_samples_ = c.get<uint64_t>();
     mutations_ = c.get<uint64_t>(), accepted_ = c.get<uint64_t>(), large_steps_ = c.get<uint64_t>();
     large_accepted_ = c.get<uint64_t>(), zero_proposals_ = c.get<uint64_t>();
@@ -260,7 +258,7 @@ nlohmann::json PSSMLTIntegrator::describe() const {
 }
 
 nlohmann::json PSSMLTIntegrator::statistics() const {
-    nlohmann::json j = {{"normalization", b_},
+    nlohmann::json j = {{"normalization", normalization()},
                         {"normalization_samples", f_samples_},
                         {"mutations", mutations_},
                         {"acceptance", mutations_ ? double(accepted_) / double(mutations_) : 0.0},

@@ -62,9 +62,10 @@ public:
     // returned. Public for tests.
     float evaluate(const Scene &scene, PrimarySampleSpaceSampler &sampler, std::vector<Contribution> &out,
                    RenderCounters &counters) const;
-    double normalization() const { return b_; }  // b, once the bootstrap has run
+    // b, the mean of f over its samples so far (0 before the bootstrap).
+    double normalization() const { return f_samples_ > 0 ? f_sum_ / double(f_samples_) : 0.0; }
     // The splats are c / f: the image is them times b, whose estimate improves as the render goes.
-    double splat_scale() const override { return b_; }
+    double splat_scale() const override { return normalization(); }
 
 private:
     struct Chain {
@@ -88,7 +89,7 @@ private:
     bool map_changed_ = false;  // the inner integrator learned since the chains' states were evaluated
     // b: the mean of f over the bootstrap and every large step of the completed passes (each an
     // independent uniform sample of u), so the image's brightness converges as its noise does.
-    double b_ = 0, f_sum_ = 0, pass_f_sum_ = 0;
+    double f_sum_ = 0, pass_f_sum_ = 0;
     uint64_t f_samples_ = 0, pass_f_samples_ = 0;
     uint64_t mutations_ = 0, accepted_ = 0, large_steps_ = 0, large_accepted_ = 0, zero_proposals_ = 0;
 };
