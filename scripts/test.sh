@@ -2,7 +2,7 @@
 # The whole test suite: installs what it needs (Debian packages, the Python venv with Mitsuba 3),
 # builds, then runs the C++ tests (ctest, then again under ASan+UBSan, and the parallel parts under TSan),
 # the fuzz targets for 30 s each,
-# and the Python tests (pytest: CLI, comparison with Mitsuba 3).
+# and the Python tests (pytest: CLI, the Python package, comparison with Mitsuba 3).
 set -euo pipefail
 ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 # valgrind: tests/python/test_instructions.py runs bench/instructions.py, which counts instructions with it;
@@ -10,6 +10,9 @@ ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 "$ROOT/scripts/install_deps.sh" valgrind chromium
 "$ROOT/scripts/setup_python.sh"
 "$ROOT/scripts/build.sh"
+# The neepp Python package, built and installed as a user's `pip install .` does (its build folder,
+# build/python-*, is kept, so a second run rebuilds only what changed); tests/python/test_package.py.
+"$ROOT/.venv/bin/python" -m pip install -q --no-build-isolation "$ROOT"
 # The instruction-count test runs neepp under valgrind, which cannot run a -march=native build of an
 # AVX-512 CPU: it gets a build for x86-64-v3, on every CPU alike.
 "$ROOT/scripts/build_valgrind.sh"

@@ -22,6 +22,9 @@
 #ifndef NEEPP_SCENES_DIR
 #define NEEPP_SCENES_DIR "scenes"
 #endif
+#ifndef NEEPP_VERSION
+#define NEEPP_VERSION "unknown"
+#endif
 
 namespace {
 
@@ -141,7 +144,9 @@ Rendered run_render(const RenderArgs &a) {
     job.seed = a.seed;
     job.threads = a.threads;
     job.sampler = a.sampler.empty() ? scene->settings.sampler : a.sampler;
-    job.progress = !a.quiet && isatty(STDERR_FILENO);
+    // A redrawn bar on a terminal; elsewhere (a log file, a batch system) a line per tenth of the render.
+    job.progress = a.quiet ? neepp::ProgressStyle::none
+                           : isatty(STDERR_FILENO) ? neepp::ProgressStyle::bar : neepp::ProgressStyle::log;
     job.cancel = &g_cancel;
     // --checkpoint writes the render's state beside the image (OUTPUT.checkpoint) and the image so far;
     // --resume continues from that state. A render that reaches its sample count removes it.
@@ -209,6 +214,16 @@ neepp::Image side_by_side(const neepp::Image &left, const neepp::Image &right) {
     return out;
 }
 
+// The built-in scenes: beside the binary's folder (the checkout's build/../scenes, or the Python package's
+// neepp/bin/../scenes), else where the checkout was when it was built.
+std::string scenes_dir() {
+    namespace fs = std::filesystem;
+    std::error_code ec;
+    const fs::path beside = fs::canonical("/proc/self/exe", ec).parent_path().parent_path() / "scenes";
+    if (!ec && fs::exists(beside / "door-ajar" / "scene.xml")) return beside.string();
+    return NEEPP_SCENES_DIR;
+}
+
 // One comparison of the demo: scene rendered with the baseline options at spp, then with the NEE++
 // options for the same wall time; writes demo_<base>/<alt> images and statistics, a side-by-side PNG,
 // and returns the pair's summary.
@@ -218,7 +233,7 @@ nlohmann::json demo_pair(const std::string &dir, const std::string &scene, int s
                          const std::string &integrator = "") {
     RenderArgs a_args;
     a_args.integrator = integrator;
-    a_args.scene = std::string(NEEPP_SCENES_DIR) + "/" + scene + "/scene.xml";
+    a_args.scene = scenes_dir() + "/" + scene + "/scene.xml";
     a_args.output = dir + "/demo_" + base + ".exr";
     a_args.stats = dir + "/demo_" + base + ".json";
     a_args.spp = spp;
@@ -327,6 +342,7 @@ int main(int argc, char **argv) {
     neepp::restart_with_huge_pages(argv);  // once, before anything is allocated (see huge_pages.h)
     CLI::App app{"neepp: a physically based renderer with Next Event Estimation++"};
     app.require_subcommand(1);
+    app.set_version_flag("--version", std::string("neepp ") + NEEPP_VERSION);
 
     RenderArgs ra;
     auto *render = app.add_subcommand("render", "Render a Mitsuba 3 XML scene");

@@ -12,6 +12,9 @@ import numpy as np
 
 EPS = 0.01
 
+__all__ = ["EPS", "downsample", "relmse_map", "relmse", "relative_variance", "rmse", "mean_abs_rel_error",
+           "image_mean", "mean_stderr", "relmse_stderr", "all_metrics", "paired_ratios"]
+
 
 def _pair(img, ref):
     a = np.asarray(img, dtype=np.float64)

@@ -121,7 +121,7 @@ RenderResult render(const Scene &scene, Integrator &integrator, const RenderJob 
         double f = spp_done / double(job.spp);
         return timed ? std::max(f, elapsed() / job.time_limit_s) : f;
     };
-    ProgressBar bar(fraction, job.progress);
+    ProgressBar bar(fraction, job.progress, job.on_progress);
 
     integrator.prepare(scene);
     double seconds_per_spp = 0;

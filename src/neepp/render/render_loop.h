@@ -8,6 +8,7 @@
 #include <string>
 #include "neepp/io/image.h"
 #include "neepp/render/checkpoint.h"
+#include "neepp/render/progress_bar.h"
 #include "neepp/render/stats.h"
 
 namespace neepp {
@@ -21,7 +22,10 @@ struct RenderJob {
     uint64_t seed = 0;
     int threads = 0;              // 0 = all cores
     std::string sampler = "independent";
-    bool progress = false;        // draw a progress bar with ETA on stderr
+    ProgressStyle progress = ProgressStyle::none;  // a bar with ETA on stderr, or log lines
+    // Called a few times a second, from a thread of the render's own, with the fraction done and the
+    // seconds elapsed (the Python package's progress callback).
+    std::function<void(double fraction, double elapsed_s)> on_progress;
     const std::atomic<bool> *cancel = nullptr;  // set asynchronously (e.g. by SIGINT) to stop early
     int tile_size = 32;
     // Checkpoints: at the end of a pass, once checkpoint_interval_s has passed since the last, and when
