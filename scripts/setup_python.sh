@@ -2,7 +2,8 @@
 # Create the project's Python virtualenv (.venv, git-ignored) with the tools used by
 # python/neepp_tools, tests/python and bench/: numpy, pytest, matplotlib, pillow, Mitsuba 3
 # (the peer renderer), flip-evaluator (NVIDIA FLIP, for neepp compare), and nanobind and scikit-build-core,
-# with which scripts/test.sh installs the neepp package into it (pip install --no-build-isolation). Also installs libllvm19 (Debian 12 main) for Mitsuba's llvm_ad_rgb
+# with which scripts/test.sh installs the neepp package into it (pip install --no-build-isolation), and Ray
+# (neepp.distributed). Also installs libllvm19 (Debian 12 main) for Mitsuba's llvm_ad_rgb
 # variant, which must then be run with DRJIT_LIBLLVM_PATH set (neepp_tools.runner does it).
 # Idempotent; safe to rerun. Usage: scripts/setup_python.sh [VENV_DIR]
 set -euo pipefail
@@ -21,6 +22,7 @@ REQS=(
   "flip-evaluator>=1.7"
   "nanobind>=2.4"
   "scikit-build-core>=0.10"
+  "ray>=2.9"
 )
 
 # libllvm19 for the llvm variant (LLVM 14/15 make Dr.Jit abort). Skip apt when present.
@@ -41,14 +43,14 @@ if "$VENV/bin/python" - "${REQS[@]}" <<'PY' 2>/dev/null
 import sys
 from importlib.metadata import version
 want = {"numpy": None, "pytest": None, "matplotlib": None, "pillow": None, "mitsuba": "3.9.", "flip-evaluator": None,
-        "nanobind": None, "scikit-build-core": None}
+        "nanobind": None, "scikit-build-core": None, "ray": None}
 for name, prefix in want.items():
     v = version(name)
     if prefix and not v.startswith(prefix):
         sys.exit(1)
 PY
 then
-  echo "setup_python: $VENV already has numpy, pytest, matplotlib, pillow, mitsuba 3.9, flip-evaluator, nanobind, scikit-build-core"
+  echo "setup_python: $VENV already has numpy, pytest, matplotlib, pillow, mitsuba 3.9, flip-evaluator, nanobind, scikit-build-core, ray"
 else
   "$VENV/bin/python" -m pip install -q --upgrade pip
   "$VENV/bin/python" -m pip install -q "${REQS[@]}"

@@ -311,29 +311,56 @@ void run_demo(const std::string &dir, int spp, bool quiet) {
     }
 }
 
-// `neepp compare` is neepp_tools.compare (Python: the metrics, NVIDIA FLIP, the plots and the page); this
-// runs it with the project's interpreter (NEEPP_PYTHON, else the checkout's .venv, else python3) and
-// tells it which neepp to render with. Does not return.
-[[noreturn]] void run_compare(const std::vector<std::string> &args) {
+// The parts of the CLI written in Python run with the project's interpreter: NEEPP_PYTHON, else the Python
+// of the venv this binary was installed into by `pip install .` (VENV/lib/pythonX.Y/site-packages/neepp/bin),
+// else the checkout's .venv, else python3. The checkout's python/ goes on PYTHONPATH. Does not return.
+[[noreturn]] void exec_python(const std::string &what, std::vector<std::string> words) {
     namespace fs = std::filesystem;
+    std::error_code ec;
+    const fs::path self = fs::canonical("/proc/self/exe", ec);
     const char *env = std::getenv("NEEPP_PYTHON");
+    const fs::path installed = ec ? fs::path() : self.parent_path().parent_path().parent_path().parent_path().parent_path()
+                                                        .parent_path() / "bin" / "python";
     const std::string venv = std::string(NEEPP_SOURCE_DIR) + "/.venv/bin/python";
-    const std::string python = env && *env ? env : fs::exists(venv) ? venv : "python3";
+    const std::string python = env && *env                                                      ? env
+                               : !ec && self.parent_path().parent_path().filename() == "neepp" &&
+                                         fs::exists(installed) ? installed.string()
+                               : fs::exists(venv)              ? venv
+                                                               : "python3";
     const char *old_path = std::getenv("PYTHONPATH");
     const std::string path = std::string(NEEPP_SOURCE_DIR) + "/python" + (old_path && *old_path ? std::string(":") + old_path : "");
     setenv("PYTHONPATH", path.c_str(), 1);
-    std::error_code ec;
-    const fs::path self = fs::canonical("/proc/self/exe", ec);
-    std::vector<std::string> words = {python, "-m", "neepp_tools.compare"};
-    if (!ec) words.insert(words.end(), {"--neepp", self.string()});
-    words.insert(words.end(), args.begin(), args.end());
+    words.insert(words.begin(), python);
     std::vector<char *> argv;
     for (std::string &w : words) argv.push_back(w.data());
     argv.push_back(nullptr);
     execvp(argv[0], argv.data());
-    fmt::print(stderr, "neepp: error: cannot run {} for neepp compare: {} (scripts/setup_python.sh sets up its Python)\n",
-               python, std::strerror(errno));
+    fmt::print(stderr, "neepp: error: cannot run {} for {}: {} (scripts/setup_python.sh sets up its Python)\n", python,
+               what, std::strerror(errno));
     std::exit(1);
+}
+
+// `neepp compare` is neepp_tools.compare (Python: the metrics, NVIDIA FLIP, the plots and the page), told
+// which neepp to render with.
+[[noreturn]] void run_compare(const std::vector<std::string> &args) {
+    std::error_code ec;
+    const std::filesystem::path self = std::filesystem::canonical("/proc/self/exe", ec);
+    std::vector<std::string> words = {"-m", "neepp_tools.compare"};
+    if (!ec) words.insert(words.end(), {"--neepp", self.string()});
+    words.insert(words.end(), args.begin(), args.end());
+    exec_python("neepp compare", words);
+}
+
+// `neepp render --ray [ADDRESS] --workers N` is neepp.distributed's command line (the Python package),
+// given the render's arguments as they were typed.
+[[noreturn]] void run_distributed(int argc, char **argv) {
+    std::vector<std::string> words = {"-m", "neepp.distributed"};
+    bool after_render = false;
+    for (int i = 1; i < argc; ++i) {
+        if (after_render) words.push_back(argv[i]);
+        after_render = after_render || std::string(argv[i]) == "render";
+    }
+    exec_python("neepp render --ray", words);
 }
 
 }  // namespace
@@ -379,6 +406,14 @@ int main(int argc, char **argv) {
                      "Continue the render saved in OUTPUT.checkpoint (same scene, options and seed) to the same image an "
                      "uninterrupted render gives");
     render->add_flag("-q,--quiet", ra.quiet, "No progress bar or messages");
+    std::string ray_address;
+    int workers = 2;
+    render->add_option("--ray", ray_address,
+                       "Render on Ray workers (the Python package's neepp.distributed): on a local Ray instance "
+                       "(loopback only), or on the cluster at ADDRESS")
+        ->expected(0, 1);
+    render->add_option("--workers", workers, "With --ray: how many workers render the image (each with --threads)")
+        ->check(CLI::Range(1, 4096));
 
     std::string demo_dir = "neepp-demo";
     int demo_spp = 64;
@@ -397,6 +432,7 @@ int main(int argc, char **argv) {
 
     CLI11_PARSE(app, argc, argv);
     if (*compare) run_compare(compare->remaining());
+    if (*render && (render->count("--ray") > 0 || render->count("--workers") > 0)) run_distributed(argc, argv);
     std::signal(SIGINT, on_stop_signal);
     std::signal(SIGTERM, on_stop_signal);
     try {

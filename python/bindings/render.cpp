@@ -11,6 +11,7 @@
 #include <nanobind/stl/map.h>
 #include <nanobind/stl/pair.h>
 #include <nanobind/stl/string.h>
+#include <nanobind/stl/vector.h>
 #include "bindings.h"
 #include "neepp/integrators/integrator.h"
 #include "neepp/render/render_output.h"
@@ -20,40 +21,48 @@ namespace neepp::python {
 
 namespace {
 
-std::pair<nb::ndarray<nb::numpy, float>, std::string> render_scene(const Scene &scene, const std::string &integrator_name,
-                                                                   const std::map<std::string, std::string> &overrides,
-                                                                   int spp, double time_s, uint64_t seed, int threads,
-                                                                   const std::string &sampler, nb::object progress) {
+std::unique_ptr<Integrator> scene_integrator(const Scene &scene, const std::string &name,
+                                             const std::map<std::string, std::string> &overrides) {
     Options options(scene.settings.integrator_options);
     for (const auto &[key, value] : overrides) options.set(key, value);
-    const std::string name = integrator_name.empty() ? scene.settings.integrator : integrator_name;
-    std::unique_ptr<Integrator> integrator = make_integrator(name, options);
+    return make_integrator(name.empty() ? scene.settings.integrator : name, options);
+}
 
-    std::atomic<bool> cancel{false};
-    std::atomic<double> fraction{0};
+RenderJob make_job(const Scene &scene, int spp, double time_s, uint64_t seed, int threads, const std::string &sampler) {
     RenderJob job;
     job.spp = spp > 0 ? spp : (time_s > 0 ? 0 : scene.settings.spp);
     job.time_limit_s = time_s;
     job.seed = seed;
     job.threads = threads;
     job.sampler = sampler.empty() ? scene.settings.sampler : sampler;
+    return job;
+}
+
+struct Watched {
+    RenderResult result;
+    bool interrupted = false;  // by Ctrl-C
+};
+
+// Renders on a thread of its own while this (the Python) thread forwards progress and watches for Ctrl-C.
+Watched render_watched(const Scene &scene, Integrator &integrator, RenderJob job, nb::object progress) {
+    std::atomic<bool> cancel{false};
+    std::atomic<double> fraction{0};
     job.cancel = &cancel;
     const bool callback = !progress.is_none() && PyCallable_Check(progress.ptr());
     if (!callback && nb::bool_(progress)) job.progress = ProgressStyle::bar;
     job.on_progress = [&](double f, double) { fraction = f; };
 
-    RenderResult result;
+    Watched watched;
     std::exception_ptr failure;
     std::mutex mutex;
     std::condition_variable finished;
     bool done = false;
-    bool interrupted = false;
     std::optional<nb::python_error> raised;  // by the callback or a signal handler: ends the render, raised after it
     {
         nb::gil_scoped_release release;
         std::thread worker([&] {
             try {
-                result = render(scene, *integrator, job);
+                watched.result = render(scene, integrator, job);
             } catch (...) {
                 failure = std::current_exception();
             }
@@ -70,7 +79,7 @@ std::pair<nb::ndarray<nb::numpy, float>, std::string> render_scene(const Scene &
                     cancel = true;
                     if (PyErr_ExceptionMatches(PyExc_KeyboardInterrupt)) {  // Ctrl-C: keep the image, as the CLI does
                         PyErr_Clear();
-                        interrupted = true;
+                        watched.interrupted = true;
                     } else {
                         raised.emplace();
                     }
@@ -91,14 +100,92 @@ std::pair<nb::ndarray<nb::numpy, float>, std::string> render_scene(const Scene &
     if (raised) throw *raised;
     if (failure) std::rethrow_exception(failure);
     if (callback) progress(1.0);
-    nlohmann::json stats = render_statistics(scene, *integrator, result, job);
-    if (interrupted) stats["interrupted"] = true;
-    return {to_numpy(std::move(result.image)), stats.dump()};
+    return watched;
+}
+
+std::pair<nb::ndarray<nb::numpy, float>, std::string> render_scene(const Scene &scene, const std::string &integrator_name,
+                                                                   const std::map<std::string, std::string> &overrides,
+                                                                   int spp, double time_s, uint64_t seed, int threads,
+                                                                   const std::string &sampler, nb::object progress) {
+    std::unique_ptr<Integrator> integrator = scene_integrator(scene, integrator_name, overrides);
+    const RenderJob job = make_job(scene, spp, time_s, seed, threads, sampler);
+    Watched w = render_watched(scene, *integrator, job, progress);
+    nlohmann::json stats = render_statistics(scene, *integrator, w.result, job);
+    if (w.interrupted) stats["interrupted"] = true;
+    return {to_numpy(std::move(w.result.image)), stats.dump()};
+}
+
+template <typename T> nb::ndarray<nb::numpy, T> vector_to_numpy(std::vector<T> &&v) {
+    auto *owned = new std::vector<T>(std::move(v));
+    nb::capsule owner(owned, [](void *p) noexcept { delete static_cast<std::vector<T> *>(p); });
+    return nb::ndarray<nb::numpy, T>(owned->data(), {owned->size()}, owner);
+}
+
+template <typename T> std::vector<T> numpy_to_vector(const nb::ndarray<const T, nb::ndim<1>, nb::c_contig, nb::device::cpu> &a) {
+    return std::vector<T>(a.data(), a.data() + a.shape(0));
+}
+
+// One range of sample indices, [first, last), continued from what earlier ranges learned (state, empty:
+// nothing): its sums, what it learned, and its statistics. The unit of distributed rendering.
+nb::dict render_range(const Scene &scene, const std::string &integrator_name,
+                      const std::map<std::string, std::string> &overrides, int first, int last, uint64_t seed,
+                      int threads, const std::string &sampler, const nb::bytes &state, nb::object progress) {
+    if (first < 0 || last <= first) throw std::invalid_argument("render_range: the range must be 0 <= first < last");
+    std::unique_ptr<Integrator> integrator = scene_integrator(scene, integrator_name, overrides);
+    if (integrator->renders_passes())
+        throw std::invalid_argument("integrator '" + integrator->describe().value("name", std::string()) +
+                                    "' renders whole passes itself (its Markov chains), which cannot be split by sample index");
+    RenderJob job = make_job(scene, last, 0, seed, threads, sampler);
+    job.first_sample = first;
+    const std::string state_in(state.c_str(), state.size());
+    if (!state_in.empty()) job.integrator_state = &state_in;
+    job.keep_state = true;
+    Watched w = render_watched(scene, *integrator, job, progress);
+    if (w.interrupted) {  // not a partial range: nothing of it counts
+        PyErr_SetNone(PyExc_KeyboardInterrupt);
+        throw nb::python_error();
+    }
+    RenderCheckpoint &c = w.result.state;
+    nb::dict out;
+    out["first"] = first;
+    out["last"] = last;
+    out["image_sums"] = vector_to_numpy(std::move(c.image_sums));
+    out["splat_sums"] = vector_to_numpy(std::move(c.splat_sums));
+    out["light_paths"] = c.light_paths;
+    out["integrator_state"] = nb::bytes(c.integrator_state.data(), c.integrator_state.size());
+    out["stats"] = render_statistics(scene, *integrator, w.result, job).dump();
+    return out;
 }
 
 }  // namespace
 
 void bind_render(nb::module_ &m) {
+    using Doubles = nb::ndarray<const double, nb::ndim<1>, nb::c_contig, nb::device::cpu>;
+    using Int64s = nb::ndarray<const int64_t, nb::ndim<1>, nb::c_contig, nb::device::cpu>;
+    m.def("render_range", &render_range, nb::arg("scene"), nb::arg("integrator"), nb::arg("options"), nb::arg("first"),
+          nb::arg("last"), nb::arg("seed"), nb::arg("threads"), nb::arg("sampler"), nb::arg("state"),
+          nb::arg("progress").none(),
+          "Renders samples first..last-1 of every pixel, continued from state (bytes; empty: nothing learned yet). "
+          "Returns a dict: image_sums (float64: r, g, b, weight per pixel), splat_sums (int64 fixed point), "
+          "light_paths, integrator_state (bytes: what it learned) and stats (JSON). Sums of several ranges add up; "
+          "image_from_sums makes their image. Used by neepp.distributed.");
+    m.def("image_from_sums", [](const Scene &scene, const Doubles &image_sums, const Int64s &splat_sums, double light_paths) {
+              return to_numpy(image_from_sums(scene, numpy_to_vector<double>(image_sums), numpy_to_vector<int64_t>(splat_sums),
+                                              light_paths));
+          },
+          nb::arg("scene"), nb::arg("image_sums"), nb::arg("splat_sums"), nb::arg("light_paths"),
+          "The (H, W, 3) image that render_range's sums (added up over ranges) make.");
+    m.def("merge_states", [](const std::string &integrator, const std::map<std::string, std::string> &options,
+                             const nb::bytes &base, const std::vector<nb::bytes> &learned) {
+              const std::unique_ptr<Integrator> i = make_integrator(integrator, Options(options));
+              std::vector<std::string> states;
+              for (const nb::bytes &b : learned) states.emplace_back(b.c_str(), b.size());
+              const std::string merged = i->merge_states(std::string(base.c_str(), base.size()), states);
+              return nb::bytes(merged.data(), merged.size());
+          },
+          nb::arg("integrator"), nb::arg("options"), nb::arg("base"), nb::arg("learned"),
+          "What several ranges continued from base learned, as one state (NEE++: the first's, with the visibility "
+          "counts the others added).");
     m.def("render", &render_scene, nb::arg("scene"), nb::arg("integrator"), nb::arg("options"), nb::arg("spp"),
           nb::arg("time"), nb::arg("seed"), nb::arg("threads"), nb::arg("sampler"), nb::arg("progress").none(),
           "Renders the scene; returns the (H, W, 3) float32 image and the statistics as JSON text. "

@@ -296,3 +296,43 @@ TEST(NeeppRender, RejectionNeedsEnoughOccludedShadowRays) {
     EXPECT_THROW(make_integrator("path", Options(OptionMap{{"shadow_rays", "neepp"}, {"min_occluded", "1.5"}})),
                  std::invalid_argument);
 }
+
+// Distributed rendering merges what renders of different sample ranges learned: the merged map holds the
+// base's counts plus every render's additions, exactly, with the first render's other state.
+TEST(NeeppRender, MergedStatesAddWhatEachRenderLearned) {
+    auto scene = load_scene(two_rooms_path());
+    NeeppOptions o;
+    o.defer_seeding = false;
+    NeeppShadowRays base(o);
+    base.prepare(*scene);
+    const std::string base_state = base.save_state();
+    const VisibilityMap &b = base.map();
+    uint64_t seeded = 0, fresh = 0;  // a pair the seeding measured, and one it did not
+    while (b.counts_at(seeded).traced == 0) ++seeded;
+    while (b.counts_at(fresh).traced != 0) ++fresh;
+
+    auto learned = [&](uint64_t pair_a, uint32_t visible, uint32_t traced) {
+        NeeppShadowRays r(o);
+        r.prepare(*scene);
+        r.restore_state(base_state);
+        r.mutable_map().add(pair_a, visible, traced);
+        r.mutable_map().add(seeded, 1, 2);
+        return r.save_state();
+    };
+    const std::string first = learned(fresh, 3, 5), second = learned(fresh + 1, 0, 7);
+    const std::string merged_state = base.merge_states(base_state, {first, second});
+    NeeppShadowRays merged(o);
+    merged.prepare(*scene);
+    merged.restore_state(merged_state);
+    const VisibilityMap &m = merged.map();
+    for (uint64_t p = 0; p < m.pair_count(); ++p) {
+        PairCounts want = b.counts_at(p);
+        if (p == seeded) want = {uint16_t(want.visible + 2), uint16_t(want.traced + 4)};
+        if (p == fresh) want = {3, 5};
+        if (p == fresh + 1) want = {0, 7};
+        ASSERT_EQ(m.counts_at(p).visible, want.visible) << p;
+        ASSERT_EQ(m.counts_at(p).traced, want.traced) << p;
+    }
+    EXPECT_EQ(base.merge_states(base_state, {}), base_state);
+    EXPECT_EQ(base.merge_states(base_state, {first}), first);
+}

@@ -94,6 +94,12 @@ public:
     // An integrator that keeps anything between passes must carry it here.
     virtual std::string save_state() const { return {}; }
     virtual void restore_state(const Scene &scene, const std::string &state) {}
+    // Distributed rendering (render ranges of sample indices on several machines): each range's render
+    // continued from the state `base` and learned something (`learned`, in range order); returns the state
+    // that holds what all of them learned, which the next ranges continue from.
+    virtual std::string merge_states(const std::string &base, const std::vector<std::string> &learned) const {
+        return learned.empty() ? base : learned.front();
+    }
     // Name and effective options, for the statistics file.
     virtual nlohmann::json describe() const = 0;
     // Extra statistics of this integrator (map size, rays skipped...), merged into the stats file.

@@ -30,6 +30,9 @@ public:
     bool learns_between_passes() const override { return shadow_->learns_between_passes(); }
     // What the shadow-ray component has learned (NEE++'s map, phase, calibration).
     std::string save_state() const override { return shadow_->save_state(); }
+    std::string merge_states(const std::string &base, const std::vector<std::string> &learned) const override {
+        return shadow_->merge_states(base, learned);
+    }
     void restore_state(const Scene &scene, const std::string &state) override;
     nlohmann::json statistics() const override;
     Color Li(const Scene &scene, const Ray &ray, Sampler &sampler, RenderCounters &counters) const override;

@@ -75,6 +75,17 @@ PassStatistics pass_statistics(int pass_index, int spp, int pass_size, const std
     return ps;
 }
 
+
+// The image: the accumulated samples plus the splat layer (if any), scaled by pixels / light paths.
+Image combine_layers(const ImageBlock &samples, const SplatFilm *splats, double light_paths, double splat_scale) {
+    Image image = samples.resolve();
+    if (splats && light_paths > 0) {
+        const Image splat = splats->resolve(double(image.width) * image.height / light_paths * splat_scale);
+        for (size_t i = 0; i < image.data.size(); ++i) image.data[i] += splat.data[i];
+    }
+    return image;
+}
+
 }  // namespace
 
 RenderResult render(const Scene &scene, Integrator &integrator, const RenderJob &job) {
@@ -118,7 +129,8 @@ RenderResult render(const Scene &scene, Integrator &integrator, const RenderJob 
     auto fraction = [&]() -> double {
         if (timed && job.spp <= 0) return elapsed() / job.time_limit_s;
         double spp_done = spp_done_now.load() + double(samples_done.load()) / (double(W) * H);
-        double f = spp_done / double(job.spp);
+        const int first = job.resume ? 0 : job.first_sample;
+        double f = (spp_done - first) / double(job.spp - first);
         return timed ? std::max(f, elapsed() / job.time_limit_s) : f;
     };
     ProgressBar bar(fraction, job.progress, job.on_progress);
@@ -139,14 +151,14 @@ RenderResult render(const Scene &scene, Integrator &integrator, const RenderJob 
         spp_done_now = result.spp;
         integrator.restore_state(scene, c.integrator_state);
     }
-    // The image so far: the accumulated samples plus the splat layer, scaled by pixels / light paths.
+    if (!job.resume && job.first_sample > 0) {  // a range of sample indices (distributed rendering)
+        if (job.spp <= job.first_sample) throw std::invalid_argument("render: the sample range is empty");
+        result.spp = job.first_sample;
+        spp_done_now = result.spp;
+    }
+    if (!job.resume && job.integrator_state) integrator.restore_state(scene, *job.integrator_state);
     auto current_image = [&] {
-        Image image = accumulated.resolve();
-        if (splatting && light_paths > 0) {
-            const Image splat = splats_accumulated->resolve(double(W) * H / light_paths * integrator.splat_scale());
-            for (size_t i = 0; i < image.data.size(); ++i) image.data[i] += splat.data[i];
-        }
-        return image;
+        return combine_layers(accumulated, splats_accumulated.get(), light_paths, integrator.splat_scale());
     };
     // Light paths the pass's camera samples splatted (an integrator's own pass body counts its own).
     auto camera_sample_light_paths = [&] {
@@ -160,7 +172,7 @@ RenderResult render(const Scene &scene, Integrator &integrator, const RenderJob 
         return sum;
     };
     RenderCounters counted_at_pass_start;  // what a checkpoint of a pass cut short holds
-    auto checkpoint = [&](const RenderCounters &counted_so_far) {
+    auto make_checkpoint = [&](const RenderCounters &counted_so_far) {
         RenderCheckpoint c;
         c.spp = result.spp;
         c.passes = result.passes;
@@ -171,7 +183,10 @@ RenderResult render(const Scene &scene, Integrator &integrator, const RenderJob 
         c.image_sums = accumulated.sums();
         if (splatting) c.splat_sums = splats_accumulated->sums();
         c.integrator_state = integrator.save_state();
-        job.on_checkpoint(c, current_image());
+        return c;
+    };
+    auto checkpoint = [&](const RenderCounters &counted_so_far) {
+        job.on_checkpoint(make_checkpoint(counted_so_far), current_image());
         last_checkpoint = elapsed();
     };
     for (;;) {
@@ -307,7 +322,22 @@ RenderResult render(const Scene &scene, Integrator &integrator, const RenderJob 
     result.counters = counted();
     result.occlusion_time_s = double(result.counters.occlusion_ticks) * seconds_per_tick();
     result.image = current_image();
+    if (job.keep_state) result.state = make_checkpoint(result.counters);
     return result;
+}
+
+Image image_from_sums(const Scene &scene, const std::vector<double> &image_sums, const std::vector<int64_t> &splat_sums,
+                      double light_paths, double splat_scale) {
+    const int W = scene.camera.width, H = scene.camera.height;
+    ReconstructionFilter filter(scene.settings.rfilter, scene.settings.rfilter_radius, scene.settings.rfilter_stddev);
+    ImageBlock image(0, 0, W, H, &filter);
+    image.set_sums(image_sums);
+    std::unique_ptr<SplatFilm> splats;
+    if (!splat_sums.empty()) {
+        splats = std::make_unique<SplatFilm>(W, H, &filter);
+        splats->set_sums(splat_sums);
+    }
+    return combine_layers(image, splats.get(), light_paths, splat_scale);
 }
 
 }  // namespace neepp

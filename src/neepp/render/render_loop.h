@@ -39,6 +39,13 @@ struct RenderJob {
     // pass that ends once the render time has grown snapshot_growth times since the last snapshot.
     double snapshot_growth = 1.5;
     std::function<void(int spp, double render_time_s, const Image &)> on_snapshot;
+    // Distributed rendering splits an image by sample index: this render's samples are first_sample ..
+    // spp - 1 (the image holds spp - first_sample of them), what the integrator learns starts from
+    // integrator_state (what renders of earlier ranges learned, restored right after prepare) when given,
+    // and the result carries its sums (RenderResult::state), which add up across ranges.
+    int first_sample = 0;
+    const std::string *integrator_state = nullptr;
+    bool keep_state = false;
 };
 
 struct RenderResult {
@@ -50,8 +57,14 @@ struct RenderResult {
     double occlusion_time_s = 0;
     std::string stopped_by = "spp";  // spp, time, cancel
     int resumed_spp = 0;             // samples per pixel the render was resumed with (0: not resumed)
+    RenderCheckpoint state;          // with RenderJob::keep_state: the sums and the integrator's state at the end
 };
 
 RenderResult render(const Scene &scene, Integrator &integrator, const RenderJob &job);
+
+// The image that a render's sums make (RenderCheckpoint's image_sums, splat_sums and light_paths; those of
+// several renders of different sample ranges added up), with the scene's film and filter.
+Image image_from_sums(const Scene &scene, const std::vector<double> &image_sums, const std::vector<int64_t> &splat_sums,
+                      double light_paths, double splat_scale = 1.0);
 
 }  // namespace neepp

@@ -118,4 +118,18 @@ VisibilityMap decode_visibility_map(const std::string &bytes, const std::string 
     return map;
 }
 
+std::pair<VoxelGrid, VisibilityMap> decode_visibility_map(const std::string &bytes, const std::string &what,
+                                                          uint64_t fingerprint) {
+    // The header's grid (after magic and version: resolution, bins, bounds); the full decode checks the rest.
+    BinaryReader r{bytes, std::min<size_t>(bytes.size(), 8 + 4), what};
+    const uint32_t n = r.get<uint32_t>();
+    r.get<uint32_t>();
+    const Vec3 lo = r.get<Vec3>(), hi = r.get<Vec3>();
+    if (n < 1 || n > uint32_t(VoxelGrid::kMaxResolution) || !(BBox{lo, hi}.valid()))
+        throw std::runtime_error(fmt::format("{}: malformed grid", what));
+    VoxelGrid grid = VoxelGrid::with_exact_bounds(BBox{lo, hi}, int(n));
+    VisibilityMap map = decode_visibility_map(bytes, what, grid, fingerprint);
+    return {grid, std::move(map)};
+}
+
 }  // namespace neepp

@@ -9,6 +9,7 @@
 #pragma once
 #include <cstdint>
 #include <string>
+#include <utility>
 #include "neepp/io/checksum.h"
 #include "neepp/visibility/visibility_map.h"
 #include "neepp/visibility/voxel_grid.h"
@@ -41,5 +42,9 @@ VisibilityMap load_visibility_map(const std::string &path, const VoxelGrid &grid
 std::string encode_visibility_map(const VoxelGrid &grid, const VisibilityMap &map, uint64_t fingerprint);
 VisibilityMap decode_visibility_map(const std::string &bytes, const std::string &what, const VoxelGrid &grid,
                                     uint64_t fingerprint);
+// The same for bytes whose grid is not known beforehand (merging the maps several renders learned): the
+// grid they were encoded for comes back with the map.
+std::pair<VoxelGrid, VisibilityMap> decode_visibility_map(const std::string &bytes, const std::string &what,
+                                                          uint64_t fingerprint);
 
 }  // namespace neepp

@@ -259,33 +259,90 @@ void NeeppShadowRays::end_pass(const PassStatistics &pass) {
     totals_.merge_time_s += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }
 
+namespace {
+
+// A saved state's parts: the learning's phase and calibration, its totals, and the map's file bytes.
+template <typename Totals> struct SavedState {
+    uint8_t phase = 0;
+    double adaptive_scale = 0;
+    Totals totals;
+    SeedingStats seeding;
+    std::string map_source;
+    bool has_map = false;
+    std::string map_bytes;
+
+    std::string encode() const {
+        BinaryWriter w;
+        w.put(phase);
+        w.put(adaptive_scale);
+        w.put(totals);
+        w.put(seeding);
+        w.put_string(map_source);
+        w.put(uint8_t(has_map));
+        if (has_map) w.put_string(map_bytes);
+        return std::move(w.bytes);
+    }
+    static SavedState decode(const std::string &bytes) {
+        BinaryReader r{bytes, 0, "checkpoint: NEE++ state"};
+        SavedState s;
+        s.phase = r.get<uint8_t>();
+        s.adaptive_scale = r.get<double>();
+        s.totals = r.get<Totals>();
+        s.seeding = r.get<SeedingStats>();
+        s.map_source = r.get_string();
+        s.has_map = r.get<uint8_t>() != 0;
+        if (s.has_map) s.map_bytes = r.get_string();
+        return s;
+    }
+};
+
+}  // namespace
+
 std::string NeeppShadowRays::save_state() const {
-    BinaryWriter w;
-    w.put(uint8_t(phase_));
-    w.put(adaptive_scale_);
-    w.put(totals_);
-    w.put(seeding_);
-    w.put_string(map_source_);
-    const bool has_map = map_.cell_count() != 0;
-    w.put(uint8_t(has_map));
-    if (has_map) w.put_string(encode_visibility_map(grid_, map_, 0));
-    return std::move(w.bytes);
+    SavedState<Totals> s{uint8_t(phase_), adaptive_scale_, totals_, seeding_, map_source_, map_.cell_count() != 0, {}};
+    if (s.has_map) s.map_bytes = encode_visibility_map(grid_, map_, 0);
+    return s.encode();
 }
 
 void NeeppShadowRays::restore_state(const std::string &state) {
-    BinaryReader r{state, 0, "checkpoint: NEE++ state"};
-    const uint8_t phase = r.get<uint8_t>();
-    if (phase > uint8_t(Phase::Off)) throw std::runtime_error("checkpoint: NEE++ state: bad phase");
-    phase_ = Phase(phase);
-    adaptive_scale_ = r.get<double>();
-    totals_ = r.get<Totals>();
-    seeding_ = r.get<SeedingStats>();
-    map_source_ = r.get_string();
-    if (r.get<uint8_t>()) {
-        map_ = decode_visibility_map(r.get_string(), "checkpoint: NEE++ map", grid_, 0);
-    } else {
-        map_ = VisibilityMap();
+    const auto s = SavedState<Totals>::decode(state);
+    if (s.phase > uint8_t(Phase::Off)) throw std::runtime_error("checkpoint: NEE++ state: bad phase");
+    phase_ = Phase(s.phase);
+    adaptive_scale_ = s.adaptive_scale;
+    totals_ = s.totals;
+    seeding_ = s.seeding;
+    map_source_ = s.map_source;
+    map_ = s.has_map ? decode_visibility_map(s.map_bytes, "checkpoint: NEE++ map", grid_, 0) : VisibilityMap();
+}
+
+std::string NeeppShadowRays::merge_states(const std::string &base, const std::vector<std::string> &learned) const {
+    if (learned.empty()) return base;
+    auto merged = SavedState<Totals>::decode(learned.front());
+    if (!merged.has_map || learned.size() == 1) return learned.front();
+    const char *what = "merging NEE++ states";
+    auto [grid, map] = decode_visibility_map(merged.map_bytes, what, 0);
+    // What each other render added to the base map (a base without a map: all it holds). Learning stops
+    // at learn_until (far below the counts' halving at 65535), so these differences are what it traced.
+    VisibilityMap base_map;
+    if (!base.empty()) {
+        const auto b = SavedState<Totals>::decode(base);
+        if (b.has_map) base_map = decode_visibility_map(b.map_bytes, what, grid, 0);
     }
+    for (size_t i = 1; i < learned.size(); ++i) {
+        const auto other = SavedState<Totals>::decode(learned[i]);
+        if (!other.has_map) continue;
+        const VisibilityMap theirs = decode_visibility_map(other.map_bytes, what, grid, 0);
+        for (uint64_t pair = 0; pair < theirs.pair_count(); ++pair) {
+            const PairCounts c = theirs.counts_at(pair);
+            if (c.traced == 0) continue;
+            const PairCounts b = base_map.pair_count() ? base_map.counts_at(pair) : PairCounts{};
+            const int traced = int(c.traced) - int(b.traced);
+            const int visible = std::clamp(int(c.visible) - int(b.visible), 0, std::max(traced, 0));
+            if (traced > 0) map.add(pair, uint64_t(visible), uint64_t(traced));
+        }
+    }
+    merged.map_bytes = encode_visibility_map(grid, map, 0);
+    return merged.encode();
 }
 
 nlohmann::json NeeppShadowRays::describe() const {

@@ -99,6 +99,8 @@ public:
     // The phase, the adaptive calibration, the totals and the map (its known pairs).
     std::string save_state() const override;
     void restore_state(const std::string &state) override;
+    // The first render's state, with the counts every other render added to the base map (counts add).
+    std::string merge_states(const std::string &base, const std::vector<std::string> &learned) const override;
     nlohmann::json describe() const override;
     nlohmann::json statistics() const override;
 

@@ -65,6 +65,11 @@ public:
     // after prepare(scene), so that a resumed render's passes read what the uninterrupted one's would.
     virtual std::string save_state() const { return {}; }
     virtual void restore_state(const std::string &state) {}
+    // Distributed rendering: several renders continued from the state `base` and each learned something
+    // (`learned`, in a fixed order); the state that holds what all of them learned.
+    virtual std::string merge_states(const std::string &base, const std::vector<std::string> &learned) const {
+        return learned.empty() ? base : learned.front();
+    }
     // The policy's effective options (for the integrator's description) and its figures (map size and
     // build cost, roulette decisions...) for the statistics file.
     virtual nlohmann::json describe() const { return {{"policy", policy()}}; }

@@ -1,0 +1,390 @@
+"""One image rendered by several workers on Ray (pip install "neepp[distributed]", or ray).
+
+    image, stats = neepp.distributed.render("scene.xml", spp=256, workers=4, resx=640, resy=360)
+    image, stats = neepp.distributed.render("scene.xml", time=60, address="ray://head:10001", workers=16,
+                                            integrator="path", options={"shadow_rays": "neepp-adaptive"})
+
+The image is split by sample index, not by tile: every worker renders every pixel, for a range of sample
+indices [first, last), and returns its unnormalised sums (Σw·L and Σw per pixel, the splats apart in fixed
+point). The driver adds them up in range order and forms the image once, so BDPT's splats, which land on
+any pixel, and the filter's footprint across tile edges come out as in one render, and the result is the
+same to the bit whatever the number of machines, for the same ranges.
+
+Rendering goes in rounds. The first renders sample 0 alone: integrators that learn between passes (NEE++
+seeds its visibility map and decides whether rejection pays) do it once. Every later round's ranges start
+from what the earlier rounds learned: the workers' NEE++ maps are merged (the counts each added are
+summed) between rounds and sent back with the next ranges, and rounds grow geometrically so that the map
+learns early, as the render loop's passes do. An integrator that learns nothing renders everything left in
+the second round.
+
+A worker that dies has its range rendered again by Ray (tasks are retried; only a finished range's sums
+are ever added, so nothing is lost or counted twice). A scene that a worker cannot load (a cluster whose
+workers lack its files) raises the worker's SceneError in the driver.
+
+Security: without an address, ray.init() starts a local Ray instance on this machine, listening on the
+loopback interface only (127.0.0.1). With an address, the cluster's head and workers listen where that
+cluster was started; Ray's own authentication (and TLS, RAY_USE_TLS) is what protects it, and anyone who
+can reach its ports can run code on it: keep a cluster on a private network.
+"""
+from __future__ import annotations
+
+import json
+import os
+import signal
+import sys
+import threading
+import time as _time
+from typing import Callable, Dict, List, Optional, Union
+
+import numpy as np
+
+from . import _neepp, load, option_text
+
+__all__ = ["render", "schedule_rounds"]
+
+# Statistics that add up over ranges.
+_SUMMED = ["rays", "camera_rays", "light_rays", "splats", "shadow_rays", "shadow_rays_occluded",
+           "shadow_rays_skipped", "occlusion_time_s", "invalid_samples"]
+
+_scenes: Dict[str, object] = {}  # a worker process's loaded scenes (Ray reuses processes across tasks)
+
+
+def _scene(path: str, params: Dict[str, str]):
+    key = json.dumps([path, sorted(params.items())])
+    if key not in _scenes:
+        _scenes.clear()  # one scene at a time: they can be large
+        _scenes[key] = load(path, **params)
+    return _scenes[key]
+
+
+def _maybe_die_for_test(first: int) -> None:
+    # Test hook (tests/python/test_distributed.py): the first task to claim the marker kills its own process
+    # 0.3 s into its render, as a machine lost mid-range would be.
+    folder = os.environ.get("NEEPP_DISTRIBUTED_KILL_ONCE")
+    if not folder or first == 0:
+        return
+    try:
+        fd = os.open(os.path.join(folder, "killed"), os.O_CREAT | os.O_EXCL | os.O_WRONLY)
+    except FileExistsError:
+        return
+    os.write(fd, str(os.getpid()).encode())
+    os.close(fd)
+    threading.Timer(0.3, lambda: os.kill(os.getpid(), signal.SIGKILL)).start()
+
+
+def _render_range(path: str, params: Dict[str, str], integrator: str, options: Dict[str, str], first: int, last: int,
+                  seed: int, threads: int, sampler: str, state: bytes) -> dict:
+    """One range of sample indices of one image (a Ray task, or called in-process)."""
+    _maybe_die_for_test(first)
+    scene = _scene(path, params)
+    t0 = _time.monotonic()
+    out = _neepp.render_range(scene, integrator, options, first, last, seed, threads, sampler, state, None)
+    out["wall_s"] = _time.monotonic() - t0
+    return out
+
+
+def schedule_rounds(spp: int, workers: int, learns: bool, first_round: int = 1) -> List[List[tuple]]:
+    """The ranges [first, last) of each round after the first (which is [0, first_round)): for an integrator
+    that learns, rounds of workers ranges whose size doubles (1, 2, 4... spp each); otherwise one round
+    of `workers` ranges. Depends on its arguments only, so a render's ranges are the same on any cluster
+    of the same worker count."""
+    rounds, start, size = [], first_round, 1
+    while start < spp:
+        if learns:
+            per = size
+            size *= 2
+        else:
+            per = -(-(spp - start) // workers)
+        ranges = []
+        for _ in range(workers):
+            if start >= spp:
+                break
+            end = min(spp, start + per)
+            ranges.append((start, end))
+            start = end
+        rounds.append(ranges)
+    return rounds
+
+
+class _Local:
+    """Runs the tasks in this process, one after another (the reference a cluster's image must equal)."""
+
+    def submit(self, *args):
+        return _render_range(*args)
+
+    def wait(self, handles, on_done):
+        for h in handles:
+            on_done(h)
+        return list(handles)
+
+
+class _Ray:
+    def __init__(self, address: Optional[str], workers: int, threads: int):
+        if not address:
+            # On Linux, Ray gives a local instance the machine's network address and listens there (for
+            # clusters); this setting keeps it on 127.0.0.1, so nothing of it is reachable from the network.
+            os.environ.setdefault("RAY_ENABLE_WINDOWS_OR_OSX_CLUSTER", "0")
+        import ray
+        self.ray = ray
+        if not ray.is_initialized():
+            if address:
+                ray.init(address=address, log_to_driver=False)
+            else:
+                from ray._private import ray_constants  # read at start-up: when ray was imported before us
+                ray_constants.ENABLE_RAY_CLUSTER = False
+                ray.init(num_cpus=max(workers * threads, 1), include_dashboard=False, log_to_driver=False)
+        self.task = ray.remote(num_cpus=threads, max_retries=3)(_render_range)
+
+    def submit(self, *args):
+        return self.task.remote(*args)
+
+    def wait(self, handles, on_done):
+        pending, results = list(handles), {}
+        while pending:
+            done, pending = self.ray.wait(pending, num_returns=1)
+            for ref in done:
+                try:
+                    results[ref] = self.ray.get(ref)
+                except self.ray.exceptions.RayTaskError as e:
+                    raise _cause(e) from None
+                on_done(results[ref])
+        return [results[h] for h in handles]
+
+
+def _cause(error):
+    """The worker's own exception (SceneError, ValueError...) rather than Ray's wrapper, with the worker named."""
+    cause = getattr(error, "cause", None)
+    if isinstance(cause, BaseException):
+        try:
+            cause.add_note(f"(raised on a Ray worker, pid {getattr(error, 'pid', '?')})")
+        except AttributeError:
+            pass
+        return cause
+    return error
+
+
+class _Bar:
+    def __init__(self, progress):
+        self.callback = progress if callable(progress) else None
+        self.draw = progress is True
+        self.t0 = _time.monotonic()
+
+    def __call__(self, fraction: float) -> None:
+        fraction = min(max(fraction, 0.0), 1.0)
+        if self.callback:
+            self.callback(fraction)
+        if self.draw:
+            elapsed = _time.monotonic() - self.t0
+            eta = elapsed * (1 - fraction) / fraction if fraction > 0.005 else float("nan")
+            filled = int(fraction * 40)
+            sys.stderr.write(f"\r[{'=' * filled}{'>' if filled < 40 else ''}{' ' * max(39 - filled, 0)}] "
+                             f"{100 * fraction:5.1f}% {elapsed:.1f}s elapsed, ETA {eta:.1f}s   ")
+            if fraction >= 1:
+                sys.stderr.write("\n")
+            sys.stderr.flush()
+
+
+def render(scene_path, spp: Optional[int] = None, time: Optional[float] = None, workers: int = 2,
+           address: Optional[str] = None, integrator: Optional[str] = None, options: Optional[dict] = None,
+           seed: Optional[int] = None, threads: int = 1, sampler: Optional[str] = None,
+           progress: Union[None, bool, Callable[[float], None]] = None, local: bool = False, **params):
+    """Renders a scene on `workers` Ray workers (each with `threads` threads); returns ``(image, stats)`` as
+    neepp.render does. Scene parameters are keyword arguments (as neepp.load's), integrator options a dict.
+
+    spp: samples per pixel (default: the scene's), or time: seconds to render for. address: a Ray cluster
+    (default: a local Ray instance, started on the loopback interface if none is running). progress: a
+    callable given the fraction done, or True for a bar on stderr. local=True runs the same ranges in this
+    process, without Ray: the image a cluster must match to the bit.
+    """
+    if spp is not None and time is not None:
+        raise ValueError("give spp or time, not both")
+    if workers < 1 or threads < 1:
+        raise ValueError("workers and threads must be at least 1")
+    if time is not None and not time > 0:
+        raise ValueError(f"time must be positive, got {time}")
+    path = os.path.abspath(os.fspath(scene_path))
+    params = {k: option_text(v) for k, v in params.items()}
+    scene = load(path, **params)  # errors in the scene surface here, before any worker starts
+    name = integrator or scene.integrator
+    opts = dict(scene.integrator_options)
+    opts.update({k: option_text(v) for k, v in (options or {}).items()})
+    if name == "pssmlt":
+        raise ValueError("pssmlt cannot be rendered distributed: its Markov chains are not split by sample index")
+    seed = scene.seed if seed is None else int(seed)
+    sampler = sampler or scene.sampler
+    total = spp if spp is not None else (None if time is not None else scene.spp)
+    if total is not None and total < 1:
+        raise ValueError(f"spp must be at least 1, got {total}")
+    bar = _Bar(progress)
+    t0 = _time.monotonic()
+    runner = _Local() if local else _Ray(address, workers, threads)
+
+    def task(first, last, state):
+        return runner.submit(path, params, name, opts, first, last, seed, threads, sampler, state)
+
+    results = []
+    done_spp = [0]
+
+    def fraction():
+        if total is None:
+            return (_time.monotonic() - t0) / time
+        return done_spp[0] / total
+
+    def on_done(r):
+        done_spp[0] += r["last"] - r["first"]
+        bar(fraction())
+
+    first = runner.wait([task(0, 1, b"")], on_done)[0]
+    results.append(first)
+    state = first["integrator_state"]
+    learns = len(state) > 0
+    seconds_per_spp = first["wall_s"]  # per worker: every worker renders every pixel
+    rounds = 1
+    if total is not None:
+        plan = schedule_rounds(total, workers, learns)
+    else:
+        plan = None
+    next_start, size = 1, 1
+    while True:
+        if plan is not None:
+            if rounds - 1 >= len(plan):
+                break
+            ranges = plan[rounds - 1]
+        else:  # time: rounds sized to what is left, growing as for spp while learning
+            left = time - (_time.monotonic() - t0)
+            per = int(left / max(seconds_per_spp, 1e-6) * 0.9)
+            if learns:
+                per = min(per, size)
+                size *= 2
+            if per < 1:
+                break
+            ranges = [(next_start + i * per, next_start + (i + 1) * per) for i in range(workers)]
+            next_start += workers * per
+        round_t0 = _time.monotonic()
+        out = runner.wait([task(a, b, state) for a, b in ranges], on_done)
+        seconds_per_spp = (_time.monotonic() - round_t0) / max(b - a for a, b in ranges)
+        results.extend(out)
+        if learns:
+            state = _neepp.merge_states(name, opts, state, [r["integrator_state"] for r in out])
+        rounds += 1
+    bar(1.0)
+    return _merge(scene, results, time_s=_time.monotonic() - t0, workers=workers, rounds=rounds,
+                  address=address, local=local, stopped_by="spp" if total is not None else "time")
+
+
+def _merge(scene, results: List[dict], time_s: float, workers: int, rounds: int, address, local: bool,
+           stopped_by: str):
+    """The image and statistics of all ranges: sums added in range order (so the same ranges give the same
+    bits however they were spread), the image formed once."""
+    results = sorted(results, key=lambda r: r["first"])
+    image_sums = np.zeros_like(results[0]["image_sums"])
+    splat_sums = np.zeros_like(results[0]["splat_sums"])
+    light_paths = 0.0
+    for r in results:
+        image_sums += r["image_sums"]
+        splat_sums += r["splat_sums"]
+        light_paths += r["light_paths"]
+    image = _neepp.image_from_sums(scene, image_sums, splat_sums, light_paths)
+    per_range = [json.loads(r["stats"]) for r in results]
+    spp = sum(r["last"] - r["first"] for r in results)
+    stats = dict(per_range[-1])
+    for key in _SUMMED:
+        stats[key] = sum(s.get(key, 0) for s in per_range)
+    stats.update(spp=spp, passes=sum(s["passes"] for s in per_range), render_time_s=time_s,
+                 samples_per_s=spp * scene.width * scene.height / time_s if time_s > 0 else 0.0,
+                 stopped_by=stopped_by, threads=None)
+    stats["integrator"] = per_range[0]["integrator"]
+    stats["distributed"] = {"workers": workers, "rounds": rounds, "ranges": [[r["first"], r["last"]] for r in results],
+                            "address": address or ("in-process" if local else "local"),
+                            "worker_render_time_s": sum(r["wall_s"] for r in results)}
+    return image[..., :3], stats
+
+
+def main(argv=None) -> int:
+    """`neepp render SCENE --ray [ADDRESS] --workers N ...` (the CLI hands its render arguments here)."""
+    import argparse
+    from . import write_exr, write_png
+
+    ap = argparse.ArgumentParser(prog="neepp render --ray", description="Render one image on Ray workers.")
+    ap.add_argument("scene")
+    ap.add_argument("-o", "--output", default="render.exr")
+    ap.add_argument("--spp", type=int)
+    ap.add_argument("--time", type=float)
+    ap.add_argument("--seed", type=int)
+    ap.add_argument("--threads", type=int, default=1, help="threads per worker")
+    ap.add_argument("-D", action="append", default=[], metavar="NAME=VALUE")
+    ap.add_argument("--integrator")
+    ap.add_argument("-I", action="append", default=[], metavar="KEY=VALUE")
+    ap.add_argument("--sampler")
+    ap.add_argument("--stats")
+    ap.add_argument("-q", "--quiet", action="store_true")
+    ap.add_argument("--ray", nargs="?", const="", default="", metavar="ADDRESS")
+    ap.add_argument("--workers", type=int, default=2)
+    for unsupported in ["--checkpoint", "--snapshots", "--visibility-map", "--rfilter"]:
+        ap.add_argument(unsupported, help=argparse.SUPPRESS)
+    ap.add_argument("--resume", action="store_true", help=argparse.SUPPRESS)
+    a = ap.parse_args(argv)
+    for name in ["checkpoint", "snapshots", "visibility_map", "rfilter"]:
+        if getattr(a, name) is not None:
+            ap.error(f"--{name.replace('_', '-')} is not available with --ray")
+    if a.resume:
+        ap.error("--resume is not available with --ray")
+
+    def pairs(items, flag):
+        out = {}
+        for item in items:
+            key, eq, value = item.partition("=")
+            if not eq or not key:
+                ap.error(f"{flag} expects name=value, got '{item}'")
+            out[key] = value
+        return out
+
+    if not a.output.endswith(".exr"):
+        ap.error(f"the output image '{a.output}' must end in .exr")
+    for path in [a.output, a.stats]:  # before rendering, as the CLI checks: a typing slip costs no render
+        if path:
+            folder = os.path.dirname(os.path.abspath(path))
+            os.makedirs(folder, exist_ok=True)
+            if not os.access(folder, os.W_OK):
+                ap.error(f"cannot write '{path}': the folder '{folder}' is not writable")
+    params = pairs(a.D, "-D")
+    params.pop("spp", None)  # the sample count is --spp's (neepp.load's keywords cannot be spp or time)
+    params.pop("time", None)
+    try:
+        image, stats = render(a.scene, spp=a.spp, time=a.time, workers=a.workers, address=a.ray or None,
+                              integrator=a.integrator, options=pairs(a.I, "-I"), seed=a.seed, threads=a.threads,
+                              sampler=a.sampler, progress=None if a.quiet else sys.stderr.isatty() or
+                              _LogLines(), **params)
+    except (ValueError, RuntimeError, OSError) as e:
+        print(f"neepp: error: {e}", file=sys.stderr)
+        return 1
+    except KeyboardInterrupt:
+        print("neepp: interrupted (a distributed render keeps no partial image)", file=sys.stderr)
+        return 130
+    write_exr(a.output, image)
+    png = os.path.splitext(a.output)[0] + ".png"
+    write_png(png, image)
+    if a.stats:
+        with open(a.stats, "w") as f:
+            json.dump(stats, f, indent=2)
+            f.write("\n")
+    if not a.quiet:
+        print(f"neepp: {stats['spp']} spp on {a.workers} workers in {stats['render_time_s']:.2f} s "
+              f"({stats['samples_per_s'] * 1e-6:.3f} M samples/s), wrote {a.output} and {png}", file=sys.stderr)
+    return 0
+
+
+class _LogLines:
+    """Progress as a line per tenth of the render, for logs (stderr is not a terminal)."""
+
+    def __init__(self):
+        self.tenth = 0
+
+    def __call__(self, fraction: float) -> None:
+        if int(fraction * 10) > self.tenth:
+            self.tenth = int(fraction * 10)
+            print(f"neepp: {100 * fraction:5.1f}% done", file=sys.stderr, flush=True)
+
+
+if __name__ == "__main__":
+    sys.exit(main())
