@@ -7,11 +7,14 @@
 #include <cstring>
 #include <filesystem>
 #include <iostream>
+#include <optional>
 #include <stdexcept>
 #include <unistd.h>
 #include <CLI/CLI.hpp>
 #include <fmt/core.h>
 #include "neepp/integrators/integrator.h"
+#include "neepp/integrators/option_table.h"
+#include "neepp/loader/supported_plugins.h"
 #include "neepp/io/atomic_file.h"
 #include "neepp/light_selection/factory.h"
 #include "neepp/loader/scene_loader.h"
@@ -51,7 +54,8 @@ struct RenderArgs {
     int spp = 0, threads = 0;
     double time_s = 0, checkpoint_s = 0;
     bool resume = false;
-    uint64_t seed = 0;
+    std::optional<uint64_t> seed;  // default: the scene's sampler seed
+    std::string png = "auto";      // auto: a PNG beside the EXR; none
     std::vector<std::string> defines, integrator_options;
     bool quiet = false;
 };
@@ -112,6 +116,15 @@ struct Rendered {
     nlohmann::json stats;
 };
 
+// The EXR, and the PNG beside it unless --png none; returns what was written, for messages.
+std::string write_images(const RenderArgs &a, const neepp::Image &image) {
+    if (a.png == "none") {
+        neepp::write_exr(a.output, image);
+        return "no PNG (--png none)";
+    }
+    return neepp::write_render_images(a.output, image);
+}
+
 // Loads, renders and writes one image; returns it with its statistics.
 Rendered run_render(const RenderArgs &a) {
     check_output_path(a.output, "output image", ".exr");
@@ -141,7 +154,7 @@ Rendered run_render(const RenderArgs &a) {
     neepp::RenderJob job;
     job.spp = a.spp > 0 ? a.spp : (a.time_s > 0 ? 0 : scene->settings.spp);
     job.time_limit_s = a.time_s;
-    job.seed = a.seed;
+    job.seed = a.seed.value_or(scene->settings.seed);
     job.threads = a.threads;
     job.sampler = a.sampler.empty() ? scene->settings.sampler : a.sampler;
     // A redrawn bar on a terminal; elsewhere (a log file, a batch system) a line per tenth of the render.
@@ -163,7 +176,7 @@ Rendered run_render(const RenderArgs &a) {
             neepp::RenderCheckpoint with_identity = c;
             with_identity.identity = identity.dump();
             neepp::save_checkpoint(checkpoint_path, with_identity);
-            neepp::write_render_images(a.output, image);
+            write_images(a, image);
         };
     }
     // --snapshots DIR: the image at geometrically spaced times, for convergence plots (neepp compare).
@@ -185,7 +198,7 @@ Rendered run_render(const RenderArgs &a) {
                    job.spp > 0 ? fmt::format("{} spp", job.spp) : fmt::format("{} s", job.time_limit_s));
 
     neepp::RenderResult result = neepp::render(*scene, *integrator, job);
-    std::string png = neepp::write_render_images(a.output, result.image);
+    const std::string png = write_images(a, result.image);
     // The last snapshot is the final image (unless the last pass just took it).
     if (!a.snapshots.empty() && result.spp > 0 &&
         (snapshot_index.empty() || snapshot_index.back()["spp"].get<int>() != result.spp))
@@ -212,6 +225,35 @@ neepp::Image side_by_side(const neepp::Image &left, const neepp::Image &right) {
     blit(left, 0);
     blit(right, left.width + gap);
     return out;
+}
+
+// -I's help: each integrator's options, from the option table.
+std::string options_help() {
+    std::string help;
+    for (const neepp::IntegratorDoc &d : neepp::integrator_docs()) {
+        std::string names;
+        for (const neepp::OptionDoc &o : d.options) names += (names.empty() ? "" : ", ") + o.name;
+        help += "  " + d.name + ": " + names + "\n";
+    }
+    return help;
+}
+
+// `neepp list`: what there is to choose from, with defaults and meanings.
+void print_list() {
+    fmt::print("Integrators (--integrator NAME, options as -I key=value):\n");
+    for (const neepp::IntegratorDoc &d : neepp::integrator_docs()) {
+        fmt::print("\n  {}: {}\n", d.name, d.description);
+        for (const neepp::OptionDoc &o : d.options)
+            fmt::print("    {:<18} {:<12} {}{}\n", o.name, o.default_value.empty() ? "(none)" : o.default_value, o.description,
+                       o.needs.empty() ? "" : " [with " + o.needs + "]");
+    }
+    fmt::print("\nLight samplers (-I light_sampler=NAME): ");
+    std::string samplers;
+    for (const std::string &n : neepp::light_sampler_names()) samplers += (samplers.empty() ? "" : ", ") + n;
+    fmt::print("{}\n\nShadow-ray policies (-I shadow_rays=NAME):\n", samplers);
+    for (const auto &[name, what] : neepp::shadow_ray_policy_docs()) fmt::print("  {:<16} {}\n", name, what);
+    fmt::print("\nMitsuba 3 plugins a scene may use:\n");
+    for (const auto &[kind, names] : neepp::supported_plugins()) fmt::print("  {:<11} {}\n", kind, neepp::supported_list(kind));
 }
 
 // The built-in scenes: beside the binary's folder (the checkout's build/../scenes, or the Python package's
@@ -377,18 +419,13 @@ int main(int argc, char **argv) {
     render->add_option("-o,--output", ra.output, "Output EXR (a PNG is written beside it)");
     auto *spp = render->add_option("--spp", ra.spp, "Samples per pixel (default: the scene's)")->check(CLI::Range(1, 1 << 24));
     render->add_option("--time", ra.time_s, "Render for this many seconds instead")->check(CLI::PositiveNumber)->excludes(spp);
-    render->add_option("--seed", ra.seed, "Random seed");
+    render->add_option("--seed", ra.seed, "Random seed (default: the scene's sampler seed)");
+    render->add_option("--png", ra.png, "auto: write a PNG (sRGB, clamped) beside the EXR; none: the EXR only")
+        ->check(CLI::IsMember({"auto", "none"}));
     render->add_option("--threads", ra.threads, "Worker threads (default: all cores)")->check(CLI::Range(1, 1024));
     render->add_option("-D", ra.defines, "Scene parameter override name=value (as mitsuba -D)");
     render->add_option("--integrator", ra.integrator, "Integrator (default: the scene's)");
-    std::string samplers;
-    for (const std::string &n : neepp::light_sampler_names()) samplers += (samplers.empty() ? "" : ", ") + n;
-    render->add_option("-I", ra.integrator_options,
-                       "Integrator option key=value; path: max_depth, rr_depth, hide_emitters, nee, light_sampler (" +
-                           samplers + "), shadow_rays (nee, neepp, neepp-adaptive, neepp-cv), voxels, samples_per_pair, "
-                           "q_min, learn, learn_until, min_occluded, adaptive_target, shadow_ray_cost; bdpt: mis, strategy, "
-                           "strategy_weight, light_paths, candidates, pool; pssmlt: bidirectional, bootstrap, chains, "
-                           "large_step, sigma (see README)");
+    render->add_option("-I", ra.integrator_options, "Integrator option key=value (neepp list shows all):\n" + options_help());
     render->add_option("--sampler", ra.sampler, "Sampler: independent or sobol (default: the scene's)");
     render->add_option("--rfilter", ra.rfilter, "Override the film's reconstruction filter")
         ->check(CLI::IsMember({"box", "tent", "gaussian"}));
@@ -424,6 +461,8 @@ int main(int argc, char **argv) {
     demo->add_option("--spp", demo_spp, "Samples per pixel")->check(CLI::Range(1, 1 << 20));
     demo->add_flag("-q,--quiet", demo_quiet, "No progress bar or messages");
 
+    auto *list = app.add_subcommand("list", "List the integrators with their options, the light samplers, the shadow-ray "
+                                            "policies and the Mitsuba 3 plugins scenes may use");
     auto *compare = app.add_subcommand("compare", "Render a scene with several methods at equal time (or spp) and "
                                                   "write an HTML report: neepp compare SCENE.xml --methods path,bdpt,pssmlt "
                                                   "--time S [--reference REF.exr] -o DIR (neepp compare --help for all)");
@@ -440,6 +479,8 @@ int main(int argc, char **argv) {
             run_render(ra);
         } else if (*demo) {
             run_demo(demo_dir, demo_spp, demo_quiet);
+        } else if (*list) {
+            print_list();
         }
     } catch (const std::exception &e) {
         fmt::print(stderr, "neepp: error: {}\n", e.what());

@@ -264,3 +264,41 @@ def test_demo_writes_its_outputs(neepp_bin, tmp_path):
     assert bdpt["bdpt"]["integrator"]["name"] == "bdpt" and bdpt["bdpt_neepp"]["integrator"]["light_paths"] == "neepp"
     assert bdpt["bdpt"]["splats"] > 0
     assert summary["light_selection"]["lights_visibility"]["integrator"]["light_sampler"] == "visibility"
+
+
+def test_version_and_list(neepp_bin):
+    r = run(neepp_bin, "--version")
+    assert r.returncode == 0 and r.stdout.startswith("neepp ") and r.stdout.split()[1][0].isdigit()
+    r = run(neepp_bin, "list")
+    assert r.returncode == 0, r.stderr
+    for text in ["path:", "bdpt:", "light:", "pssmlt:", "shadow_ray_cost", "light_paths", "visibility-bvh",
+                 "neepp-adaptive", "roughplastic", "envmap"]:
+        assert text in r.stdout, text
+    r = run(neepp_bin, "render", "--help")
+    assert "pssmlt: bidirectional" in r.stdout  # -I's help, from the option table
+
+
+def test_png_none_and_the_scenes_seed(neepp_bin, tmp_path):
+    r = run(neepp_bin, "render", DEMO, "-o", tmp_path / "a.exr", "--spp", 2, "--png", "none", "-q", *SMALL)
+    assert r.returncode == 0, r.stderr
+    assert (tmp_path / "a.exr").exists() and not (tmp_path / "a.png").exists()
+    # A scene's sampler seed is the render's seed unless --seed says otherwise.
+    seeded = tmp_path / "seeded.xml"
+    xml = DEMO.read_text().replace('<integer name="sample_count" value="$spp"/>',
+                                   '<integer name="sample_count" value="$spp"/><integer name="seed" value="9"/>')
+    seeded.write_text(xml.replace('filename="', f'filename="{DEMO.parent}/'))
+    images = {}
+    for name, scene, extra in [("file", seeded, []), ("flag", DEMO, ["--seed", 9]), ("zero", DEMO, [])]:
+        r = run(neepp_bin, "render", scene, "-o", tmp_path / f"{name}.exr", "--spp", 2, "-q", *SMALL, *extra,
+                "--stats", tmp_path / f"{name}.json")
+        assert r.returncode == 0, r.stderr
+        images[name] = (tmp_path / f"{name}.exr").read_bytes()
+        assert json.loads((tmp_path / f"{name}.json").read_text())["seed"] == (0 if name == "zero" else 9)
+    assert images["file"] == images["flag"] != images["zero"]
+
+
+def test_progress_is_log_lines_when_stderr_is_not_a_terminal(neepp_bin, tmp_path):
+    r = run(neepp_bin, "render", DEMO, "-o", tmp_path / "a.exr", "--time", 2.5, *SMALL)
+    assert r.returncode == 0, r.stderr
+    lines = [l for l in r.stderr.splitlines() if "% done" in l]
+    assert len(lines) >= 2 and "\r" not in r.stderr and lines[-1].startswith("neepp: 100.0% done")

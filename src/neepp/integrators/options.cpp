@@ -12,6 +12,7 @@ namespace {
 }  // namespace
 
 int Options::get_int(const std::string &key, int def) const {
+    asked_.insert(key);
     auto it = values_.find(key);
     if (it == values_.end()) return def;
     used_.insert(key);
@@ -23,6 +24,7 @@ int Options::get_int(const std::string &key, int def) const {
 }
 
 float Options::get_float(const std::string &key, float def) const {
+    asked_.insert(key);
     auto it = values_.find(key);
     if (it == values_.end()) return def;
     used_.insert(key);
@@ -34,6 +36,7 @@ float Options::get_float(const std::string &key, float def) const {
 }
 
 bool Options::get_bool(const std::string &key, bool def) const {
+    asked_.insert(key);
     auto it = values_.find(key);
     if (it == values_.end()) return def;
     used_.insert(key);
@@ -44,6 +47,7 @@ bool Options::get_bool(const std::string &key, bool def) const {
 }
 
 std::string Options::get_string(const std::string &key, const std::string &def) const {
+    asked_.insert(key);
     auto it = values_.find(key);
     if (it == values_.end()) return def;
     used_.insert(key);

@@ -20,11 +20,13 @@ public:
     std::string get_string(const std::string &key, const std::string &def) const;
     // Keys that were set but never read: a typo in -I should be an error, not silently ignored.
     std::vector<std::string> unused() const;
+    // Every key a getter was asked for, set or not (tests check the option table against it).
+    const std::set<std::string> &asked() const { return asked_; }
     const std::map<std::string, std::string> &values() const { return values_; }
 
 private:
     std::map<std::string, std::string> values_;
-    mutable std::set<std::string> used_;
+    mutable std::set<std::string> used_, asked_;
 };
 
 }  // namespace neepp

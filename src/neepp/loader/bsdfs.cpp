@@ -1,4 +1,5 @@
 #include <optional>
+#include "neepp/loader/supported_plugins.h"
 #include "neepp/loader/factories.h"
 #include "neepp/materials/conductor.h"
 #include "neepp/materials/dielectric.h"
@@ -126,9 +127,7 @@ BSDFPtr Factories::create_bsdf(const XmlNode &node) {
         if (t == "dielectric") b = std::make_shared<DielectricBSDF>(int_ior, ext_ior, r, tr);
         else b = std::make_shared<ThinDielectricBSDF>(int_ior, ext_ior, r, tr);
     } else {
-        throw node.error("unsupported BSDF type '" + t +
-                         "' (supported: diffuse, twosided, mask, bumpmap, conductor, roughconductor, plastic, "
-                         "roughplastic, dielectric, thindielectric)");
+        throw node.error("unsupported BSDF type '" + t + "' (supported: " + supported_list("bsdf") + ")");
     }
     return b;
 }

@@ -1,3 +1,4 @@
+#include "neepp/loader/supported_plugins.h"
 #include "neepp/loader/scene_loader.h"
 
 #include <cmath>
@@ -10,7 +11,7 @@ namespace neepp {
 namespace {
 
 void load_film(const XmlNode &film, Scene &scene) {
-    if (film.type != "hdrfilm") throw film.error("unsupported film '" + film.type + "' (supported: hdrfilm)");
+    if (film.type != "hdrfilm") throw film.error("unsupported film '" + film.type + "' (supported: " + supported_list("film") + ")");
     scene.camera.width = film.get_int("width", 768);
     scene.camera.height = film.get_int("height", 576);
     // Mitsuba's film also carries output settings that do not change the image.
@@ -41,7 +42,7 @@ void load_film(const XmlNode &film, Scene &scene) {
 }
 
 void load_sensor(const XmlNode &sensor, Scene &scene) {
-    if (sensor.type != "perspective") throw sensor.error("unsupported sensor '" + sensor.type + "' (supported: perspective)");
+    if (sensor.type != "perspective") throw sensor.error("unsupported sensor '" + sensor.type + "' (supported: " + supported_list("sensor") + ")");
     PerspectiveCamera &cam = scene.camera;
     cam.to_world = sensor.get_transform("to_world");
     if (sensor.has("fov")) {

@@ -1,5 +1,6 @@
 #include <cmath>
 #include <fmt/core.h>
+#include "neepp/loader/supported_plugins.h"
 #include "neepp/io/obj_reader.h"
 #include "neepp/io/ply_reader.h"
 #include "neepp/lights/area_light.h"
@@ -133,7 +134,7 @@ void Factories::shape(const XmlNode &node, Scene &scene) {
             if (!(s->radius > 0) || !std::isfinite(s->radius) || !is_finite(s->center))
                 throw node.error("sphere needs a positive radius and a finite center");
         } else {
-            throw node.error("unsupported shape type '" + t + "' (supported: obj, ply, rectangle, cube, sphere)");
+            throw node.error("unsupported shape type '" + t + "' (supported: " + supported_list("shape") + ")");
         }
     } catch (const SceneError &) {
         throw;
@@ -186,7 +187,7 @@ void Factories::emitter(const XmlNode &node, Scene &scene) {
     } else if (t == "area") {
         throw node.error("an 'area' emitter must be nested inside a <shape>");
     } else {
-        throw node.error("unsupported emitter type '" + t + "' (supported: area, envmap, constant, point)");
+        throw node.error("unsupported emitter type '" + t + "' (supported: " + supported_list("emitter") + ")");
     }
     warn_unused(node);
 }

@@ -1,4 +1,5 @@
 #include <fmt/core.h>
+#include "neepp/loader/supported_plugins.h"
 #include "neepp/loader/factories.h"
 #include "neepp/materials/bitmap_texture.h"
 #include "neepp/materials/checkerboard_texture.h"
@@ -36,7 +37,7 @@ TexturePtr Factories::texture(const XmlNode &node) {
                                                     texture_param(node, "color1", Color(0.2f)),
                                                     node.get_transform("to_uv"));
     } else {
-        throw node.error("unsupported texture type '" + node.type + "' (supported: bitmap, checkerboard)");
+        throw node.error("unsupported texture type '" + node.type + "' (supported: " + supported_list("texture") + ")");
     }
     warn_unused(node);
     textures_[&node] = tex;

@@ -1,0 +1,108 @@
+#include "neepp/integrators/option_table.h"
+
+#include <fmt/format.h>
+#include "neepp/integrators/bdpt.h"
+#include "neepp/integrators/path.h"
+#include "neepp/integrators/pssmlt.h"
+#include "neepp/light_selection/factory.h"
+#include "neepp/visibility/neepp_shadow_rays.h"
+
+namespace neepp {
+
+namespace {
+
+std::string text(bool v) { return v ? "true" : "false"; }
+std::string text(int v) { return std::to_string(v); }
+std::string text(float v) { return fmt::format("{}", v); }
+
+// The options every integrator's shadow-ray component reads (NEE++).
+std::vector<OptionDoc> shadow_ray_options() {
+    const NeeppOptions n;
+    const std::string any = "shadow_rays=neepp*";  // any NEE++ policy
+    return {
+        {"shadow_rays", "nee", "how shadow rays (and BDPT's connections) are traced: nee, neepp, neepp-adaptive, neepp-cv", ""},
+        {"voxels", text(n.voxels), "NEE++ grid resolution N (N^3 voxels)", any},
+        {"samples_per_pair", text(n.samples_per_pair), "explicit shadow rays per voxel pair when seeding the map", any},
+        {"q_min", text(n.q_min), "the least probability with which a shadow ray is traced", any},
+        {"visibility_map", "", "map file: loaded if it exists and belongs to this scene, else built and saved", any},
+        {"learn", text(n.learn), "update the map from the shadow rays the render traces", any},
+        {"learn_until", text(n.learn_until), "a pair stops learning once this many rays were traced for it", any},
+        {"min_occluded", text(n.min_occluded), "rejection stays off when the first pass finds fewer shadow rays occluded", any},
+        {"adaptive_target", n.adaptive_target, "efficiency (least time x variance) or rays (as many rays as neepp)",
+         "shadow_rays=neepp-adaptive"},
+        {"shadow_ray_cost", text(n.shadow_ray_cost), "a shadow ray's share of a sample's time, for the calibration",
+         "shadow_rays=neepp-adaptive"},
+    };
+}
+
+std::vector<IntegratorDoc> make_docs() {
+    const PathOptions p;
+    const BDPTOptions b;
+    const PSSMLTOptions m;
+    std::string samplers;
+    for (const std::string &s : light_sampler_names()) samplers += (samplers.empty() ? "" : ", ") + s;
+    auto common = [](int max_depth, int rr_depth, bool hide) {
+        return std::vector<OptionDoc>{
+            {"max_depth", text(max_depth), "longest path in edges (1: emitters only, 2: direct light, -1: unbounded)", ""},
+            {"rr_depth", text(rr_depth), "path depth from which Russian roulette may end a path", ""},
+            {"hide_emitters", text(hide), "emitters seen directly by the camera are black", ""}};
+    };
+    std::vector<IntegratorDoc> docs;
+    IntegratorDoc path{"path", "unidirectional path tracing with next event estimation and MIS (Mitsuba 3's path)",
+                       common(p.max_depth, p.rr_depth, p.hide_emitters)};
+    path.options.push_back({"nee", text(p.nee), "next event estimation (false: BSDF sampling only, the paper's Path)", ""});
+    path.options.push_back({"light_sampler", p.light_sampler, "which light NEE samples: " + samplers, ""});
+    for (OptionDoc o : shadow_ray_options()) {
+        if (o.name == "voxels") o.description += " (also the grid of the spatial and visibility light samplers)";
+        path.options.push_back(o);
+    }
+    docs.push_back(path);
+
+    IntegratorDoc bdpt{"bdpt", "bidirectional path tracing, every (s, t) strategy, MIS-weighted", common(b.max_depth, b.rr_depth, b.hide_emitters)};
+    bdpt.options.push_back({"mis", "power", "MIS heuristic: power or balance", ""});
+    bdpt.options.push_back({"strategy", "", "render only strategy S,T (s light and t camera vertices)", ""});
+    bdpt.options.push_back({"strategy_weight", "mis", "that strategy MIS-weighted (mis) or unweighted (none)", "strategy=S,T"});
+    bdpt.options.push_back({"light_paths", "independent", "independent, or neepp: NEE++ light-subpath selection", ""});
+    bdpt.options.push_back({"candidates", text(b.candidates), "K light subpaths a camera subpath chooses among", "light_paths=neepp"});
+    bdpt.options.push_back({"pool", text(b.pool), "M light subpaths traced before each pass", "light_paths=neepp"});
+    for (OptionDoc o : shadow_ray_options()) {
+        if (o.name == "voxels") o.description += " (also with light_paths=neepp)";
+        bdpt.options.push_back(o);
+    }
+    docs.push_back(bdpt);
+
+    IntegratorDoc light{"light", "light tracing (particle tracing): light paths splatted onto the film (Mitsuba 3's ptracer)",
+                        common(b.max_depth, b.rr_depth, b.hide_emitters)};
+    for (const OptionDoc &o : shadow_ray_options()) light.options.push_back(o);
+    docs.push_back(light);
+
+    IntegratorDoc pssmlt{"pssmlt",
+                         "primary-sample-space Metropolis light transport (Kelemen et al. 2002) over bdpt, or over path; "
+                         "also takes the options of the integrator it runs over",
+                         {{"bidirectional", text(m.bidirectional), "over bdpt (true) or path (false)", ""},
+                          {"bootstrap", text(m.bootstrap), "independent samples that estimate the normalization and start the chains", ""},
+                          {"chains", text(m.chains), "Markov chains", ""},
+                          {"large_step", text(m.large_step), "probability that a mutation draws every number afresh", ""},
+                          {"sigma", text(m.sigma), "standard deviation of a small step's offset of each number", ""}}};
+    docs.push_back(pssmlt);
+    return docs;
+}
+
+}  // namespace
+
+const std::vector<IntegratorDoc> &integrator_docs() {
+    static const std::vector<IntegratorDoc> docs = make_docs();
+    return docs;
+}
+
+const std::vector<std::pair<std::string, std::string>> &shadow_ray_policy_docs() {
+    static const std::vector<std::pair<std::string, std::string>> docs = {
+        {"nee", "trace every shadow ray (plain next event estimation)"},
+        {"neepp", "NEE++ (the paper): trace with probability q = max(V~, q_min), weight 1/q"},
+        {"neepp-adaptive", "NEE++ with q = c f sqrt(V~), c calibrated for least time x variance"},
+        {"neepp-cv", "NEE++ as a control variate: V~ f when skipped, corrected when traced"},
+    };
+    return docs;
+}
+
+}  // namespace neepp

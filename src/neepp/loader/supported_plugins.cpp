@@ -1,0 +1,35 @@
+#include "neepp/loader/supported_plugins.h"
+
+#include <stdexcept>
+
+namespace neepp {
+
+const std::vector<std::pair<std::string, std::vector<std::string>>> &supported_plugins() {
+    static const std::vector<std::pair<std::string, std::vector<std::string>>> plugins = {
+        {"shape", {"obj", "ply", "rectangle", "cube", "sphere"}},
+        {"bsdf", {"diffuse", "twosided", "mask", "bumpmap", "conductor", "roughconductor", "plastic", "roughplastic",
+                  "dielectric", "thindielectric"}},
+        {"texture", {"bitmap", "checkerboard"}},
+        {"emitter", {"area", "envmap", "constant", "point"}},
+        {"sensor", {"perspective"}},
+        {"film", {"hdrfilm"}},
+        {"rfilter", {"box", "tent", "gaussian"}},
+        {"sampler", {"independent", "sobol"}},
+        // Mitsuba 3's integrators, each rendered by neepp's own that gives the same image (loader/integrators.cpp).
+        {"integrator", {"path", "bdpt", "light", "pssmlt", "prb", "prb_basic", "volpath", "volpathmis", "direct",
+                        "ptracer", "moment"}},
+    };
+    return plugins;
+}
+
+std::string supported_list(const std::string &kind) {
+    for (const auto &[k, names] : supported_plugins())
+        if (k == kind) {
+            std::string list;
+            for (const std::string &n : names) list += (list.empty() ? "" : ", ") + n;
+            return list;
+        }
+    throw std::logic_error("supported_list: no plugin kind '" + kind + "'");
+}
+
+}  // namespace neepp
