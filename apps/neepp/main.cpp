@@ -56,6 +56,7 @@ struct RenderArgs {
     bool resume = false;
     std::optional<uint64_t> seed;  // default: the scene's sampler seed
     std::string png = "auto";      // auto: a PNG beside the EXR; none
+    std::vector<int> crop;         // x, y, w, h: render only this window of the film
     std::vector<std::string> defines, integrator_options;
     bool quiet = false;
 };
@@ -92,6 +93,8 @@ nlohmann::json render_identity(const neepp::Scene &scene, const neepp::Integrato
             {"seed", job.seed},
             {"sampler", job.sampler},
             {"film", fmt::format("{}x{}", scene.camera.width, scene.camera.height)},
+            {"crop", fmt::format("{},{} of {}x{}", scene.camera.crop_x, scene.camera.crop_y, scene.camera.film_width,
+                                 scene.camera.film_height)},
             {"rfilter", fmt::format("{} {} {}", scene.settings.rfilter, scene.settings.rfilter_radius,
                                     scene.settings.rfilter_stddev)}};
 }
@@ -142,6 +145,15 @@ Rendered run_render(const RenderArgs &a) {
         scene->settings.rfilter_radius = a.rfilter == "box" ? 0.5f : a.rfilter == "tent" ? 1.f : 4.f * scene->settings.rfilter_stddev;
     }
 
+    if (!a.crop.empty()) {
+        if (a.crop.size() != 4) throw std::runtime_error("--crop expects x,y,w,h");
+        try {
+            scene->camera.crop(a.crop[0], a.crop[1], a.crop[2], a.crop[3]);
+            scene->camera.finalize();
+        } catch (const std::invalid_argument &e) {
+            throw std::runtime_error(std::string("--crop: ") + e.what());
+        }
+    }
     neepp::Options options(scene->settings.integrator_options);
     if (!a.visibility_map.empty()) options.set("visibility_map", a.visibility_map);
     for (auto &o : a.integrator_options) {
@@ -420,6 +432,9 @@ int main(int argc, char **argv) {
     auto *spp = render->add_option("--spp", ra.spp, "Samples per pixel (default: the scene's)")->check(CLI::Range(1, 1 << 24));
     render->add_option("--time", ra.time_s, "Render for this many seconds instead")->check(CLI::PositiveNumber)->excludes(spp);
     render->add_option("--seed", ra.seed, "Random seed (default: the scene's sampler seed)");
+    render->add_option("--crop", ra.crop, "Render only the window x,y,w,h of the film (pixels; the image is w x h)")
+        ->delimiter(',')
+        ->expected(4);
     render->add_option("--png", ra.png, "auto: write a PNG (sRGB, clamped) beside the EXR; none: the EXR only")
         ->check(CLI::IsMember({"auto", "none"}));
     render->add_option("--threads", ra.threads, "Worker threads (default: all cores)")->check(CLI::Range(1, 1024));

@@ -302,3 +302,35 @@ def test_progress_is_log_lines_when_stderr_is_not_a_terminal(neepp_bin, tmp_path
     assert r.returncode == 0, r.stderr
     lines = [l for l in r.stderr.splitlines() if "% done" in l]
     assert len(lines) >= 2 and "\r" not in r.stderr and lines[-1].startswith("neepp: 100.0% done")
+
+
+def test_crop_renders_a_window_of_the_film(neepp_bin, tmp_path):
+    import numpy as np
+    from neepp_tools import exr
+    box = ["--rfilter", "box", "-q", "-D", "resx=64", "-D", "resy=48"]
+    full, crop = tmp_path / "full.exr", tmp_path / "crop.exr"
+    assert run(neepp_bin, "render", DEMO, "-o", full, "--spp", 8, *box).returncode == 0
+    r = run(neepp_bin, "render", DEMO, "-o", crop, "--spp", 8, "--crop", "16,8,32,24", *box)
+    assert r.returncode == 0, r.stderr
+    # Each pixel of the window draws what the whole film's pixel does: the same image, to the bit (a box
+    # filter: no sample reaches across the window's edge).
+    assert np.array_equal(exr.read_exr(crop), exr.read_exr(full)[8:32, 16:48])
+    # Mitsuba's hdrfilm crop_* properties do the same.
+    xml = DEMO.read_text().replace('<integer name="height" value="$resy"/>',
+                                   '<integer name="height" value="$resy"/><integer name="crop_offset_x" value="16"/>'
+                                   '<integer name="crop_offset_y" value="8"/><integer name="crop_width" value="32"/>'
+                                   '<integer name="crop_height" value="24"/>')
+    (tmp_path / "cropped.xml").write_text(xml)
+    r = run(neepp_bin, "render", tmp_path / "cropped.xml", "-o", tmp_path / "film.exr", "--spp", 8, *box)
+    assert r.returncode == 0, r.stderr
+    assert np.array_equal(exr.read_exr(tmp_path / "film.exr"), exr.read_exr(crop))
+    # Light tracing splats through a cropped camera: the window's mean is the whole film's there.
+    for name, extra in [("lt_full", []), ("lt_crop", ["--crop", "16,8,32,24"])]:
+        r = run(neepp_bin, "render", DEMO, "-o", tmp_path / f"{name}.exr", "--spp", 64, "--integrator", "light",
+                *box, *extra)
+        assert r.returncode == 0, r.stderr
+    a = exr.read_exr(tmp_path / "lt_full.exr")[8:32, 16:48]
+    b = exr.read_exr(tmp_path / "lt_crop.exr")
+    assert abs(a.mean() / b.mean() - 1) < 0.03, (a.mean(), b.mean())
+    r = run(neepp_bin, "render", DEMO, "-o", tmp_path / "x.exr", "--spp", 1, "--crop", "60,0,10,10", *box)
+    assert r.returncode == 1 and "not inside the 64x48 image" in r.stderr

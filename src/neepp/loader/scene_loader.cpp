@@ -23,6 +23,16 @@ void load_film(const XmlNode &film, Scene &scene) {
     if (scene.camera.width < 1 || scene.camera.height < 1 || scene.camera.width > kMaxSide || scene.camera.height > kMaxSide)
         throw film.error(fmt::format("film size {}x{} is out of range (1 to {} pixels per side)", scene.camera.width,
                                      scene.camera.height, kMaxSide));
+    // Mitsuba's crop window: the image is that part of the film.
+    const int cx = film.get_int("crop_offset_x", 0), cy = film.get_int("crop_offset_y", 0);
+    const int cw = film.get_int("crop_width", scene.camera.width - cx), ch = film.get_int("crop_height", scene.camera.height - cy);
+    if (cx != 0 || cy != 0 || cw != scene.camera.width || ch != scene.camera.height) {
+        try {
+            scene.camera.crop(cx, cy, cw, ch);
+        } catch (const std::invalid_argument &e) {
+            throw film.error(e.what());
+        }
+    }
     for (const auto &child : film.children) {
         if (child->tag != "rfilter") throw child->error("unexpected <" + child->tag + "> inside the film");
         RenderSettings &s = scene.settings;

@@ -263,10 +263,11 @@ RenderResult render(const Scene &scene, Integrator &integrator, const RenderJob 
                         for (int x = t.x0; x < t.x0 + t.w; ++x)
                             for (int s = s0; s < s0 + size; ++s) {
                                 Sampler &sampler = *samplers[queued];
-                                sampler.start_sample(uint32_t(x), uint32_t(y), uint32_t(s));
+                                // Film pixels, so that a crop's pixels draw what the whole film's do.
+                                sampler.start_sample(uint32_t(x + cam.crop_x), uint32_t(y + cam.crop_y), uint32_t(s));
                                 Vec2 jitter = sampler.next_2d();
                                 film_pos[queued] = Vec2(float(x) + jitter.x, float(y) + jitter.y);
-                                rays[queued] = cam.generate_ray({film_pos[queued].x / float(W), film_pos[queued].y / float(H)});
+                                rays[queued] = cam.pixel_ray(x, y, jitter);
                                 if (splatting) {
                                     add(film_pos[queued], integrator.Li_splat(scene, rays[queued], sampler, c, *splats_pass));
                                     continue;

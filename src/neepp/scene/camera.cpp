@@ -7,11 +7,12 @@ namespace neepp {
 void PerspectiveCamera::finalize() {
     if (width <= 0 || height <= 0) throw std::invalid_argument("film size must be positive");
     if (!(fov > 0 && fov < 180)) throw std::invalid_argument("fov must be in (0, 180) degrees");
+    const int fw = film_width > 0 ? film_width : width, fh = film_width > 0 ? film_height : height;
     float t = std::tan(0.5f * fov * kPi / 180.f);
-    float w = float(width), h = float(height), aspect = w / h;
+    float w = float(fw), h = float(fh), aspect = w / h;
     std::string axis = fov_axis;
-    if (axis == "smaller") axis = width <= height ? "x" : "y";
-    else if (axis == "larger") axis = width >= height ? "x" : "y";
+    if (axis == "smaller") axis = fw <= fh ? "x" : "y";
+    else if (axis == "larger") axis = fw >= fh ? "x" : "y";
     if (axis == "x") { tan_x_ = t; tan_y_ = t / aspect; }
     else if (axis == "y") { tan_y_ = t; tan_x_ = t * aspect; }
     else if (axis == "diagonal") {
@@ -21,14 +22,41 @@ void PerspectiveCamera::finalize() {
     } else {
         throw std::invalid_argument("unknown fov_axis '" + fov_axis + "' (x, y, diagonal, smaller, larger)");
     }
-    inv_plane_area_ = 1.f / (4.f * tan_x_ * tan_y_);
+    // The image's share of the film plane (at distance 1): the whole film's, or the crop window's.
+    inv_plane_area_ = 1.f / (4.f * tan_x_ * tan_y_ * (float(width) / w) * (float(height) / h));
+    image_scale_ = Vec2(float(width) / w, float(height) / h);
+    image_offset_ = Vec2(float(crop_x) / w, float(crop_y) / h);
     origin_ = to_world.point(Vec3(0.f));
     axis_x_ = to_world.vector(Vec3(1, 0, 0));
     axis_y_ = to_world.vector(Vec3(0, 1, 0));
     axis_z_ = to_world.vector(Vec3(0, 0, 1));
 }
 
+void PerspectiveCamera::crop(int x, int y, int w, int h) {
+    const int fw = film_width > 0 ? film_width : width, fh = film_width > 0 ? film_height : height;
+    const int fx = film_width > 0 ? crop_x : 0, fy = film_width > 0 ? crop_y : 0;
+    if (x < 0 || y < 0 || w < 1 || h < 1 || x > width - w || y > height - h)
+        throw std::invalid_argument("crop window " + std::to_string(w) + "x" + std::to_string(h) + " at (" +
+                                    std::to_string(x) + ", " + std::to_string(y) + ") is not inside the " +
+                                    std::to_string(width) + "x" + std::to_string(height) + " image");
+    film_width = fw;
+    film_height = fh;
+    crop_x = fx + x;  // a crop of a crop: offsets add up
+    crop_y = fy + y;
+    width = w;
+    height = h;
+}
+
 Ray PerspectiveCamera::generate_ray(Vec2 film) const {
+    return film_ray(image_offset_ + Vec2(film.x * image_scale_.x, film.y * image_scale_.y));
+}
+
+Ray PerspectiveCamera::pixel_ray(int x, int y, Vec2 jitter) const {
+    const int fw = film_width > 0 ? film_width : width, fh = film_width > 0 ? film_height : height;
+    return film_ray({(float(x + crop_x) + jitter.x) / float(fw), (float(y + crop_y) + jitter.y) / float(fh)});
+}
+
+Ray PerspectiveCamera::film_ray(Vec2 film) const {
     float x = (1.f - 2.f * film.x) * tan_x_, y = (1.f - 2.f * film.y) * tan_y_;
     Vec3 d_cam(x, y, 1.f);
     Vec3 d = axis_x_ * d_cam.x + axis_y_ * d_cam.y + axis_z_ * d_cam.z;
@@ -42,6 +70,7 @@ Ray PerspectiveCamera::generate_ray(Vec2 film) const {
 bool PerspectiveCamera::film_of(const Vec3 &local, Vec2 &film) const {
     if (!(local.z > 0)) return false;
     film = Vec2(0.5f * (1.f - local.x / (local.z * tan_x_)), 0.5f * (1.f - local.y / (local.z * tan_y_)));
+    film = Vec2((film.x - image_offset_.x) / image_scale_.x, (film.y - image_offset_.y) / image_scale_.y);  // -> image
     return film.x >= 0.f && film.x < 1.f && film.y >= 0.f && film.y < 1.f;
 }
 

@@ -24,11 +24,21 @@ struct PerspectiveCamera {
     float fov = 39.3077f;          // degrees, along fov_axis (the loader sets Mitsuba 3's default when a scene gives none)
     std::string fov_axis = "x";    // x, y, diagonal, smaller, larger
     float near_clip = 1e-2f, far_clip = 1e4f;
+    // A crop window (Mitsuba's hdrfilm crop_offset_x/y, crop_width/height; the CLI's --crop): the image is
+    // the width × height pixels at (crop_x, crop_y) of a film_width × film_height film, whose projection
+    // it keeps. film_width 0: no crop. Set by crop().
+    int crop_x = 0, crop_y = 0, film_width = 0, film_height = 0;
 
     // Precomputes the image-plane extent; call after changing the fields above. Throws on bad values.
     void finalize();
-    // Primary ray through continuous film position (fx, fy) in [0,1)^2.
+    // Makes the image the window (x, y, w, h) of the film (whole pixels, inside it); throws
+    // std::invalid_argument otherwise. Call finalize() after.
+    void crop(int x, int y, int w, int h);
+    // Primary ray through continuous image position (fx, fy) in [0,1)^2 (of the crop window, if any).
     Ray generate_ray(Vec2 film) const;
+    // Primary ray through image pixel (x, y) at offset jitter in [0,1)^2 within it. The position is
+    // computed in film pixels, so that a crop's pixel traces the same ray, to the bit, as the whole film's.
+    Ray pixel_ray(int x, int y, Vec2 jitter) const;
     Vec3 position() const { return to_world.point(Vec3(0.f)); }
 
     // The camera's importance, for paths traced from the lights. We is normalized as pbrt's is: over the
@@ -45,7 +55,9 @@ private:
     // Camera-space direction (not normalized) of world direction w, and the film position it meets (false
     // outside the film or behind the camera).
     bool film_of(const Vec3 &local, Vec2 &film) const;
+    Ray film_ray(Vec2 film) const;  // through film position (whole film, [0,1)^2)
     float tan_x_ = 0, tan_y_ = 0, inv_plane_area_ = 0;
+    Vec2 image_scale_{1.f, 1.f}, image_offset_{0.f, 0.f};  // the image's window in film coordinates
     Vec3 origin_, axis_x_, axis_y_, axis_z_;
 };
 

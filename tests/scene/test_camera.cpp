@@ -1,0 +1,88 @@
+// The perspective camera, whole and cropped: its direction density integrates to one over the image, its
+// importance is that density over cos θ, a connection lands where the ray through that image point
+// starts, and a crop's pixel traces the whole film's ray to the bit.
+#include <gtest/gtest.h>
+#include <cmath>
+#include "neepp/sampling/rng.h"
+#include "neepp/scene/camera.h"
+
+using namespace neepp;
+
+namespace {
+
+PerspectiveCamera camera(bool cropped) {
+    PerspectiveCamera c;
+    c.to_world = Transform::look_at(Vec3(1, 2, 3), Vec3(0, 0, 0), Vec3(0, 1, 0));
+    c.width = 64;
+    c.height = 48;
+    c.fov = 50;
+    if (cropped) c.crop(40, 6, 20, 30);
+    c.finalize();
+    return c;
+}
+
+}  // namespace
+
+TEST(Camera, DirectionDensityIntegratesToOneOverTheImage) {
+    // ∫ pdf dω over the sphere, as an integral over the plane at distance 1 (dω = cos³θ dA), with points
+    // uniform over a rectangle 1.2 times the film's: pdf must be 1 / (the image's area there) inside it.
+    const float tx = std::tan(25.f * kPi / 180.f) * 1.2f, ty = tx * 48.f / 64.f;
+    for (bool cropped : {false, true}) {
+        const PerspectiveCamera c = camera(cropped);
+        PCG32 rng(7, 1);
+        const int n = 400000;
+        double sum = 0;
+        for (int i = 0; i < n; ++i) {
+            const Vec3 local((2 * rng.next_float() - 1) * tx, (2 * rng.next_float() - 1) * ty, 1.f);
+            const Vec3 w = normalize(c.to_world.vector(local));
+            const float pdf = c.pdf_direction(w);
+            const float cos_theta = 1.f / norm(local);
+            sum += double(pdf) * cos_theta * cos_theta * cos_theta;
+            if (pdf > 0) ASSERT_NEAR(c.importance(w) * cos_theta / pdf, 1.f, 1e-4f);  // a camera ray's We cos / pdf is one
+        }
+        EXPECT_NEAR(sum / n * 4 * tx * ty, 1.0, 0.01) << (cropped ? "cropped" : "whole");
+    }
+}
+
+TEST(Camera, AConnectionLandsWhereItsRayStarts) {
+    for (bool cropped : {false, true}) {
+        const PerspectiveCamera c = camera(cropped);
+        PCG32 rng(3, 1);
+        for (int i = 0; i < 1000; ++i) {
+            const Vec2 u(rng.next_float(), rng.next_float());
+            const Ray r = c.generate_ray(u);
+            const CameraConnection k = c.connect(r.o + r.d * 5.f);
+            ASSERT_TRUE(k.valid());
+            EXPECT_NEAR(k.raster.x, u.x * float(c.width), 2e-3f);
+            EXPECT_NEAR(k.raster.y, u.y * float(c.height), 2e-3f);
+        }
+    }
+}
+
+TEST(Camera, ACropsPixelTracesTheWholeFilmsRay) {
+    const PerspectiveCamera whole = camera(false), cropped = camera(true);
+    EXPECT_EQ(cropped.width, 20);
+    EXPECT_EQ(cropped.height, 30);
+    for (int y = 0; y < 30; ++y)
+        for (int x = 0; x < 20; ++x) {
+            const Vec2 j(0.25f + 0.01f * float(x), 0.7f);
+            const Ray a = cropped.pixel_ray(x, y, j), b = whole.pixel_ray(x + 40, y + 6, j);
+            ASSERT_TRUE(a.d.x == b.d.x && a.d.y == b.d.y && a.d.z == b.d.z && a.tmin == b.tmin) << x << "," << y;
+        }
+    // Outside the crop window nothing reaches the image.
+    const Ray outside = whole.pixel_ray(10, 10, Vec2(0.5f, 0.5f));
+    EXPECT_FALSE(cropped.connect(outside.o + outside.d * 5.f).valid());
+    EXPECT_EQ(cropped.importance(outside.d), 0.f);
+}
+
+TEST(Camera, ACropOutsideTheImageIsRefused) {
+    PerspectiveCamera c = camera(false);
+    EXPECT_THROW(c.crop(60, 0, 10, 10), std::invalid_argument);
+    EXPECT_THROW(c.crop(0, 0, 0, 10), std::invalid_argument);
+    EXPECT_THROW(c.crop(-1, 0, 10, 10), std::invalid_argument);
+    c.crop(8, 8, 16, 16);  // a crop of a crop: offsets add up
+    c.crop(4, 2, 8, 8);
+    EXPECT_EQ(c.crop_x, 12);
+    EXPECT_EQ(c.crop_y, 10);
+    EXPECT_EQ(c.film_width, 64);
+}
