@@ -239,6 +239,22 @@ neepp::Image side_by_side(const neepp::Image &left, const neepp::Image &right) {
     return out;
 }
 
+// `neepp check`: every problem, one a line as compilers write them, then a count. Exit status 1 when the
+// scene has an error (render would stop), 0 when it has only warnings or nothing.
+int run_check(const std::string &scene, const std::vector<std::string> &define_args) {
+    std::map<std::string, std::string> defines;
+    for (const std::string &d : define_args) defines.insert(split_key_value(d, "-D"));
+    const std::vector<neepp::SceneProblem> problems = neepp::check_scene(scene, defines);
+    int errors = 0;
+    for (const neepp::SceneProblem &p : problems) {
+        fmt::print("{}\n", p.text());
+        errors += p.error;
+    }
+    fmt::print("{}: {} error{}, {} warning{}{}\n", scene, errors, errors == 1 ? "" : "s", problems.size() - errors,
+               problems.size() - errors == 1 ? "" : "s", errors ? "" : ": neepp renders it");
+    return errors ? 1 : 0;
+}
+
 // -I's help: each integrator's options, from the option table.
 std::string options_help() {
     std::string help;
@@ -476,6 +492,12 @@ int main(int argc, char **argv) {
     demo->add_option("--spp", demo_spp, "Samples per pixel")->check(CLI::Range(1, 1 << 20));
     demo->add_flag("-q,--quiet", demo_quiet, "No progress bar or messages");
 
+    std::string check_scene_path;
+    std::vector<std::string> check_defines;
+    auto *check = app.add_subcommand("check", "List every problem of a scene at once (unsupported plugins, missing "
+                                              "files, properties nothing reads) without rendering it");
+    check->add_option("scene", check_scene_path, "Scene file (Mitsuba 3 XML)")->required()->check(CLI::ExistingFile);
+    check->add_option("-D", check_defines, "Scene parameter override name=value (as mitsuba -D)");
     auto *list = app.add_subcommand("list", "List the integrators with their options, the light samplers, the shadow-ray "
                                             "policies and the Mitsuba 3 plugins scenes may use");
     auto *compare = app.add_subcommand("compare", "Render a scene with several methods at equal time (or spp) and "
@@ -496,6 +518,8 @@ int main(int argc, char **argv) {
             run_demo(demo_dir, demo_spp, demo_quiet);
         } else if (*list) {
             print_list();
+        } else if (*check) {
+            return run_check(check_scene_path, check_defines);
         }
     } catch (const std::exception &e) {
         fmt::print(stderr, "neepp: error: {}\n", e.what());

@@ -78,6 +78,27 @@ void bind_scene(nb::module_ &m) {
                    std::to_string(s.camera.height) + ", " + std::to_string(s.triangle_count()) + " triangles, " +
                    std::to_string(s.lights().size()) + " lights>";
         });
+    m.def("check", [](const std::filesystem::path &path, const std::map<std::string, std::string> &parameters) {
+              std::vector<SceneProblem> problems;
+              {
+                  nb::gil_scoped_release release;
+                  problems = check_scene(path.string(), parameters);
+              }
+              nb::list out;
+              for (const SceneProblem &p : problems) {
+                  nb::dict d;
+                  d["file"] = p.file;
+                  d["line"] = p.line;
+                  d["severity"] = p.error ? "error" : "warning";
+                  d["problem"] = p.problem;
+                  d["text"] = p.text();
+                  out.append(d);
+              }
+              return out;
+          },
+          nb::arg("path"), nb::arg("parameters") = std::map<std::string, std::string>{},
+          "Every problem of a scene at once, without rendering it (neepp check): a list of dicts with file, line, "
+          "severity (error or warning), problem and text.");
     m.def("load", [](const std::filesystem::path &path, const std::map<std::string, std::string> &parameters) {
               nb::gil_scoped_release release;  // meshes, textures and the BVH take a while
               return load_scene(path.string(), parameters);

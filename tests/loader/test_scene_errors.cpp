@@ -106,3 +106,37 @@ TEST(SceneLoader, DemoSceneLoads) {
 }
 
 }  // namespace
+
+// neepp check: one run lists every problem, each at its line, where loading stops at the first.
+TEST(SceneCheck, ListsEveryProblemAtOnce) {
+    const std::string xml = scene_with(  // the camera is line 2
+        "<bsdf type=\"velvet\" id=\"unused\"/>\n"                                              // 3
+        "<shape type=\"obj\"><string name=\"filename\" value=\"no-such-mesh.obj\"/></shape>\n"  // 4
+        "<shape type=\"sphere\">\n"                                                           // 5
+        "  <float name=\"radiuss\" value=\"2\"/>\n"                                            // 6
+        "  <bsdf type=\"glitter\"/>\n"                                                        // 7
+        "</shape>\n"                                                                          // 8
+        "<shape type=\"teapot\"/>\n"                                                          // 9
+        "<medium type=\"homogeneous\" id=\"fog\"/>\n");                                       // 10
+    const std::string path = write_temp_scene(xml, "many_problems.xml");
+    const std::vector<SceneProblem> problems = check_scene(path);
+    std::vector<std::pair<int, bool>> where;
+    for (const SceneProblem &p : problems) {
+        EXPECT_EQ(p.file, path);
+        where.push_back({p.line, p.error});
+    }
+    const std::vector<std::pair<int, bool>> expected = {{3, true}, {4, true}, {7, true}, {5, false}, {9, true}, {10, true},
+                                                        {0, true}};
+    EXPECT_EQ(where, expected);
+    EXPECT_NE(problems[1].problem.find("no-such-mesh.obj"), std::string::npos);
+    EXPECT_NE(problems[3].problem.find("radiuss"), std::string::npos);
+    EXPECT_NE(problems[5].problem.find("participating media"), std::string::npos);
+    EXPECT_NE(problems[6].problem.find("no light source"), std::string::npos);
+    EXPECT_EQ(problems[0].text().rfind(path + ":3: error: ", 0), 0u) << problems[0].text();
+    EXPECT_NE(load_error(xml, "many_problems.xml").find("many_problems.xml:4:"), std::string::npos);  // render: the first
+}
+
+TEST(SceneCheck, ASoundSceneHasNoProblem) {
+    const std::string path = write_temp_scene(scene_with(std::string(kLight) + "\n<shape type=\"sphere\"/>"), "sound.xml");
+    EXPECT_TRUE(check_scene(path).empty());
+}

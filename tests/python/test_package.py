@@ -130,6 +130,17 @@ def test_bad_input_raises_with_the_clis_messages(tmp_path):
         neepp.read_exr(tmp_path / "missing.exr")
 
 
+def test_check_lists_every_problem(tmp_path):
+    bad = tmp_path / "bad.xml"
+    bad.write_text('<scene version="3.0.0">\n  <shape type="teapot"/>\n  <shape type="sphere">\n'
+                   '    <float name="radiuss" value="1"/>\n  </shape>\n</scene>\n')
+    problems = neepp.check(bad)
+    # the teapot, the misspelt radius, no sensor (a default camera), no light
+    assert [(p["line"], p["severity"]) for p in problems] == [(2, "error"), (3, "warning"), (0, "warning"), (0, "error")]
+    assert "teapot" in problems[0]["problem"] and problems[0]["text"].startswith(f"{bad}:2: error: ")
+    assert neepp.check(DEMO, **SMALL) == []
+
+
 def test_visibility_map_round_trip(tmp_path):
     scene = neepp.load(DEMO, **SMALL)
     vmap = neepp.VisibilityMap.build(scene, resolution=8, samples_per_pair=8)

@@ -21,7 +21,7 @@ from . import metrics
 from . import _neepp
 from ._neepp import Scene, SceneError, VisibilityMap
 
-__all__ = ["Scene", "SceneError", "VisibilityMap", "load", "render", "read_image", "read_exr", "write_exr",
+__all__ = ["Scene", "SceneError", "VisibilityMap", "load", "check", "render", "read_image", "read_exr", "write_exr",
            "write_png", "metrics", "option_text"]
 
 
@@ -39,6 +39,13 @@ def load(path, **parameters) -> Scene:
     ``neepp.load("scene.xml", resx=128, max_depth=8)``. Raises SceneError naming the file, line and
     problem."""
     return _neepp.load(str(path), {k: option_text(v) for k, v in parameters.items()})
+
+
+def check(path, **parameters) -> list:
+    """Every problem of a scene at once, without rendering it (as `neepp check`): unsupported plugins,
+    missing files, properties nothing reads. A list of dicts with file, line, severity ("error": render
+    would stop there; "warning") and problem; empty for a scene neepp renders as written."""
+    return _neepp.check(str(path), {k: option_text(v) for k, v in parameters.items()})
 
 
 def render(scene: Scene, spp: Optional[int] = None, time: Optional[float] = None, integrator: Optional[str] = None,

@@ -6,6 +6,7 @@
 
 #include <fmt/core.h>
 #include "neepp/loader/factories.h"
+#include "neepp/loader/problems.h"
 
 namespace neepp {
 namespace {
@@ -93,15 +94,15 @@ void load_sensor(const XmlNode &sensor, Scene &scene) {
     loader::warn_unused(sensor);
 }
 
-}  // namespace
 
-std::unique_ptr<Scene> load_scene(const std::string &path, const std::map<std::string, std::string> &defines) {
+std::unique_ptr<Scene> read_scene(const std::string &path, const std::map<std::string, std::string> &defines) {
+    using loader::attempt;
     std::shared_ptr<XmlNode> root = parse_mitsuba_xml(path, defines);
     auto scene = std::make_unique<Scene>();
     scene->source_path = path;
     loader::Factories factories;
     bool have_sensor = false;
-    for (const auto &node : root->children) {
+    for (const auto &node : root->children) attempt([&] {  // when checking, a broken element is left out
         const std::string &tag = node->tag;
         if (tag == "shape") {
             factories.shape(*node, *scene);
@@ -114,23 +115,45 @@ std::unique_ptr<Scene> load_scene(const std::string &path, const std::map<std::s
         } else if (tag == "integrator") {
             loader::load_integrator(*node, scene->settings);
         } else if (tag == "bsdf" || tag == "texture") {
-            // Declared for later <ref>s; built when a shape uses them.
+            // Declared for later <ref>s; built when a shape uses them (and, when checking, now, so that one
+            // no shape uses is checked too).
+            if (loader::checking()) tag == "bsdf" ? (void)factories.bsdf(*node) : (void)factories.texture(*node);
+        } else if (tag == "medium") {
+            throw node->error("participating media are not supported yet (<medium type=\"" + node->type + "\">)");
         } else {
             throw node->error("unsupported element <" + tag + "> at the top level of the scene");
         }
-    }
+    });
     if (!have_sensor) {
         scene->camera.finalize();  // Mitsuba's default sensor would look from the origin; warn instead of guessing
-        fmt::print(stderr, "neepp: warning: {} has no <sensor>; using a default camera at the origin\n", path);
+        loader::warn(path, 0, "no <sensor>; using a default camera at the origin");
     }
     if (scene->lights().empty())
-        throw SceneError(path, "the scene has no light source (no emitter): the image would be black");
+        attempt([&] { throw SceneError(path, "the scene has no light source (no emitter): the image would be black"); });
+    return scene;
+}
+
+}  // namespace
+
+std::unique_ptr<Scene> load_scene(const std::string &path, const std::map<std::string, std::string> &defines) {
+    auto scene = read_scene(path, defines);
     try {
         scene->build();
     } catch (const std::exception &e) {
         throw SceneError(path, e.what());
     }
     return scene;
+}
+
+std::vector<SceneProblem> check_scene(const std::string &path, const std::map<std::string, std::string> &defines) {
+    std::vector<SceneProblem> problems;
+    loader::CheckingScope scope(problems);
+    try {
+        read_scene(path, defines);  // the BVH is not built: it cannot fail where loading succeeded
+    } catch (const SceneError &e) {  // what stops even a check (a malformed XML file)
+        loader::record(e);
+    }
+    return problems;
 }
 
 }  // namespace neepp

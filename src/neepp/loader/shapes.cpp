@@ -6,6 +6,7 @@
 #include "neepp/lights/area_light.h"
 #include "neepp/lights/environment_light.h"
 #include "neepp/loader/factories.h"
+#include "neepp/loader/problems.h"
 
 namespace neepp::loader {
 namespace {
@@ -145,24 +146,29 @@ void Factories::shape(const XmlNode &node, Scene &scene) {
     s->bsdf = default_bsdf();
     const XmlNode *emitter_node = nullptr;
     for (const auto &child : node.children) {
-        if (child->tag == "bsdf") s->bsdf = bsdf(*child);
-        else if (child->tag == "emitter") emitter_node = child.get();
-        else throw child->error("unsupported inside a shape: <" + child->tag + ">");
+        attempt([&] {  // when checking, a broken BSDF leaves the shape the default one
+            if (child->tag == "bsdf") s->bsdf = bsdf(*child);
+            else if (child->tag == "emitter") emitter_node = child.get();
+            else if (child->tag == "medium" || child->tag == "ref" && (child->name == "interior" || child->name == "exterior"))
+                throw child->error("participating media are not supported yet (the shape's " +
+                                   (child->tag == "medium" ? "<medium>" : child->name + " medium") + ")");
+            else throw child->error("unsupported inside a shape: <" + child->tag + ">");
+        });
     }
     warn_unused(node);
     Shape *shape = s.get();
     scene.add_shape(std::move(s));
-    if (emitter_node) {
+    if (emitter_node) attempt([&] {
         if (emitter_node->type != "area") throw emitter_node->error("a shape can only carry an 'area' emitter");
         TexturePtr radiance = texture_param(*emitter_node, "radiance", Color(1.f));
         warn_unused(*emitter_node);
         if (!has_surface(*shape)) {
-            fmt::print(stderr, "neepp: warning: {}:{}: the {} shape has no surface (no triangle of non-zero area): its "
-                               "area emitter is left out\n", node.file, node.line, node.type);
+            warn(node.file, node.line, "the " + node.type + " shape has no surface (no triangle of non-zero area): its "
+                                       "area emitter is left out");
             return;
         }
         shape->area_light = scene.add_light(std::make_unique<AreaLight>(shape, radiance));
-    }
+    });
 }
 
 void Factories::emitter(const XmlNode &node, Scene &scene) {

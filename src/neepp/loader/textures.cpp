@@ -1,6 +1,7 @@
 #include <fmt/core.h>
 #include "neepp/loader/supported_plugins.h"
 #include "neepp/loader/factories.h"
+#include "neepp/loader/problems.h"
 #include "neepp/materials/bitmap_texture.h"
 #include "neepp/materials/checkerboard_texture.h"
 
@@ -8,8 +9,7 @@ namespace neepp::loader {
 
 void warn_unused(const XmlNode &node) {
     for (const std::string &p : node.unused_properties())
-        fmt::print(stderr, "neepp: warning: {}:{}: <{} type=\"{}\"> ignores property '{}'\n", node.file, node.line,
-                   node.tag, node.type, p);
+        warn(node.file, node.line, fmt::format("<{} type=\"{}\"> ignores property '{}'", node.tag, node.type, p));
 }
 
 TexturePtr Factories::texture(const XmlNode &node) {
