@@ -5,6 +5,8 @@
 #include "common/chi2.h"
 #include "neepp/lights/area_light.h"
 #include "neepp/lights/environment_light.h"
+#include "neepp/lights/spot_light.h"
+#include "neepp/math/frame.h"
 #include "neepp/materials/texture.h"
 #include "neepp/sampling/rng.h"
 
@@ -136,3 +138,42 @@ TEST(LightEmission, PointLightEmitsItsIntensityEverywhere) {
 }
 
 }  // namespace
+
+namespace {
+
+SpotLight tilted_spot(float cutoff, float beam) {
+    return SpotLight(Transform::look_at(Vec3(0.5f, 2.f, -1.f), Vec3(0.2f, 0.f, 0.3f), Vec3(0, 1, 0)), Color(3.f, 2.f, 1.f),
+                     cutoff, beam);
+}
+
+}  // namespace
+
+// Mitsuba's spot: its rays fill the cone uniformly (chi-square), carry intensity × falloff, and add up to
+// the power it reports (intensity × ∫ falloff dω).
+TEST(LightEmission, SpotLightEmitsIntoItsConeWithItsFalloff) {
+    for (auto [cutoff, beam] : {std::pair{20.f, 15.f}, std::pair{60.f, 10.f}, std::pair{170.f, 0.f}}) {
+        const SpotLight light = tilted_spot(cutoff, beam);
+        expect_round_trip(light);
+        const Chi2Result r = chi2_directions(light, Vec2(0.5f, 0.5f));
+        ASSERT_TRUE(r.error.empty()) << r.describe();
+        EXPECT_GT(r.p_value, 1e-4) << r.describe();
+        EXPECT_NEAR(mean_flux(light), luminance(light.power()), 2e-3 * luminance(light.power())) << cutoff;
+    }
+    // The falloff: full within beam_width, linear in the angle to zero at cutoff_angle.
+    const SpotLight light = tilted_spot(20.f, 10.f);
+    const Vec3 axis = normalize(Vec3(0.2f, 0.f, 0.3f) - Vec3(0.5f, 2.f, -1.f));
+    const Frame f(axis);
+    auto at = [&](float deg) { return light.falloff(f.n * std::cos(deg * kPi / 180) + f.s * std::sin(deg * kPi / 180)); };
+    EXPECT_FLOAT_EQ(at(0.f), 1.f);
+    EXPECT_FLOAT_EQ(at(9.9f), 1.f);
+    EXPECT_NEAR(at(15.f), 0.5f, 1e-4f);
+    EXPECT_NEAR(at(17.5f), 0.25f, 1e-4f);
+    EXPECT_EQ(at(20.1f), 0.f);
+    // Seen from a point, it is a point light through the falloff.
+    Color radiance;
+    const Vec3 ref = Vec3(0.5f, 2.f, -1.f) + (f.n * std::cos(15 * kPi / 180) + f.s * std::sin(15 * kPi / 180)) * 2.f;
+    const DirectionSample ds = light.sample_direction(ref, Vec2(0.3f, 0.3f), radiance);
+    EXPECT_TRUE(ds.delta);
+    EXPECT_NEAR(radiance.x, 3.f * 0.5f / 4.f, 1e-3f);
+    EXPECT_THROW(tilted_spot(20.f, 20.f), std::invalid_argument);
+}

@@ -5,6 +5,8 @@
 #include "neepp/io/ply_reader.h"
 #include "neepp/lights/area_light.h"
 #include "neepp/lights/environment_light.h"
+#include "neepp/lights/spot_light.h"
+#include "neepp/math/frame.h"
 #include "neepp/loader/factories.h"
 #include "neepp/loader/problems.h"
 
@@ -44,6 +46,66 @@ MeshData cube_mesh() {
             else m.indices.insert(m.indices.end(), {base, base + 2, base + 1, base + 2, base, base + 3});
         }
     return m;
+}
+
+// Mitsuba's `disk` and `cylinder` are analytic; here they are meshes fine enough that the difference is
+// below any render's noise (a 256-gon's area is 1 - 1e-4 of the circle's), with Mitsuba's normals and uvs.
+constexpr int kRoundSegments = 256;
+
+// `disk`: the unit disk in the z = 0 plane, normal +z, uv = (r, φ / 2π). A fan whose triangles each have
+// their own centre vertex, so that φ interpolates within each.
+MeshData disk_mesh() {
+    MeshData m;
+    for (int i = 0; i <= kRoundSegments; ++i) {
+        const float v = float(i) / kRoundSegments, phi = 2 * kPi * v;
+        m.positions.push_back({std::cos(phi), std::sin(phi), 0});
+        m.uvs.push_back({1.f, v});
+    }
+    for (int i = 0; i < kRoundSegments; ++i) {
+        const uint32_t centre = uint32_t(m.positions.size());
+        m.positions.push_back({0, 0, 0});
+        m.uvs.push_back({0.f, (float(i) + 0.5f) / kRoundSegments});
+        m.indices.insert(m.indices.end(), {centre, uint32_t(i), uint32_t(i + 1)});
+    }
+    m.normals.assign(m.positions.size(), Vec3(0, 0, 1));
+    return m;
+}
+
+// `cylinder`: radius 1 about the z axis from z = 0 to 1, open at both ends, normals outward,
+// uv = (φ / 2π, z).
+MeshData cylinder_mesh() {
+    MeshData m;
+    for (int i = 0; i <= kRoundSegments; ++i) {
+        const float u = float(i) / kRoundSegments, phi = 2 * kPi * u;
+        const Vec3 radial(std::cos(phi), std::sin(phi), 0);
+        for (float z : {0.f, 1.f}) {
+            m.positions.push_back(radial + Vec3(0, 0, z));
+            m.normals.push_back(radial);
+            m.uvs.push_back({u, z});
+        }
+    }
+    for (uint32_t i = 0; i < uint32_t(kRoundSegments); ++i) {
+        const uint32_t b0 = 2 * i, t0 = b0 + 1, b1 = b0 + 2, t1 = b0 + 3;
+        m.indices.insert(m.indices.end(), {b0, b1, t1, t1, t0, b0});
+    }
+    return m;
+}
+
+// Mitsuba's cylinder frame: p0 to p1, of the given radius, inside the shape's to_world.
+Transform cylinder_frame(const XmlNode &node) {
+    const Vec3 p0 = node.get_vector("p0", Vec3(0, 0, 0)), p1 = node.get_vector("p1", Vec3(0, 0, 1));
+    const float radius = node.get_float("radius", 1.f), length = norm(p1 - p0);
+    if (!(radius > 0) || !std::isfinite(radius)) throw node.error("cylinder radius must be positive and finite");
+    if (!(length > 0) || !std::isfinite(length)) throw node.error("cylinder p0 and p1 must be distinct finite points");
+    const Frame f(normalize(p1 - p0));
+    Matrix4 m = Matrix4::identity();
+    for (int r = 0; r < 3; ++r) {
+        m.m[r][0] = f.s[r] * radius;
+        m.m[r][1] = f.t[r] * radius;
+        m.m[r][2] = f.n[r] * length;
+        m.m[r][3] = p0[r];
+    }
+    return Transform(m);
 }
 
 // Smooth vertex normals for meshes that have none, weighting each face by its angle at the vertex
@@ -122,6 +184,10 @@ void Factories::shape(const XmlNode &node, Scene &scene) {
             set_mesh(*s, rectangle_mesh(), to_world);
         } else if (t == "cube") {
             set_mesh(*s, cube_mesh(), to_world);
+        } else if (t == "disk") {
+            set_mesh(*s, disk_mesh(), to_world);
+        } else if (t == "cylinder") {
+            set_mesh(*s, cylinder_mesh(), to_world * cylinder_frame(node));
         } else if (t == "sphere") {
             s->kind = Shape::Kind::Sphere;
             Vec3 c = node.get_vector("center", Vec3(0.f));
@@ -190,6 +256,17 @@ void Factories::emitter(const XmlNode &node, Scene &scene) {
     } else if (t == "point") {
         Vec3 pos = node.get_vector("position", node.get_transform("to_world").point(Vec3(0.f)));
         scene.add_light(std::make_unique<PointLight>(pos, node.get_rgb("intensity", Color(1.f))));
+    } else if (t == "spot") {
+        for (const auto &child : node.children)
+            if (child->name == "texture" || child->tag == "texture") throw child->error("a spot light's projected texture is not supported");
+        const float cutoff = node.get_float("cutoff_angle", 20.f);
+        const float beam = node.get_float("beam_width", cutoff * 3.f / 4.f);
+        try {
+            scene.add_light(std::make_unique<SpotLight>(node.get_transform("to_world"), node.get_rgb("intensity", Color(1.f)),
+                                                        cutoff, beam));
+        } catch (const std::invalid_argument &e) {
+            throw node.error(e.what());
+        }
     } else if (t == "area") {
         throw node.error("an 'area' emitter must be nested inside a <shape>");
     } else {

@@ -6,11 +6,11 @@ namespace neepp {
 
 const std::vector<std::pair<std::string, std::vector<std::string>>> &supported_plugins() {
     static const std::vector<std::pair<std::string, std::vector<std::string>>> plugins = {
-        {"shape", {"obj", "ply", "rectangle", "cube", "sphere"}},
+        {"shape", {"obj", "ply", "rectangle", "cube", "sphere", "disk", "cylinder"}},
         {"bsdf", {"diffuse", "twosided", "mask", "bumpmap", "conductor", "roughconductor", "plastic", "roughplastic",
                   "dielectric", "thindielectric"}},
         {"texture", {"bitmap", "checkerboard"}},
-        {"emitter", {"area", "envmap", "constant", "point"}},
+        {"emitter", {"area", "envmap", "constant", "point", "spot"}},
         {"sensor", {"perspective"}},
         {"film", {"hdrfilm"}},
         {"rfilter", {"box", "tent", "gaussian"}},
