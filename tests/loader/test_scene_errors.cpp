@@ -140,3 +140,17 @@ TEST(SceneCheck, ASoundSceneHasNoProblem) {
     const std::string path = write_temp_scene(scene_with(std::string(kLight) + "\n<shape type=\"sphere\"/>"), "sound.xml");
     EXPECT_TRUE(check_scene(path).empty());
 }
+
+// An area emitter declared at the top level and <ref>'d by shapes lights each of them (Mitsuba's form);
+// one that no shape uses is an error at its line, not a light silently dropped.
+TEST(SceneLoader, TopLevelAreaEmittersLightTheShapesThatReferenceThem) {
+    const std::string lights = "<emitter type=\"area\" id=\"glow\"><rgb name=\"radiance\" value=\"4\"/></emitter>\n";
+    auto path = write_temp_scene(scene_with(lights + "<shape type=\"sphere\"><ref id=\"glow\"/></shape>\n"
+                                                     "<shape type=\"rectangle\"><ref id=\"glow\"/></shape>"), "ref_area.xml");
+    auto scene = load_scene(path);
+    ASSERT_EQ(scene->lights().size(), 2u);
+    EXPECT_EQ(scene->shapes()[0]->area_light, scene->lights()[0].get());
+    const std::string msg = load_error(scene_with(std::string(kLight) + "\n" + lights + "<shape type=\"sphere\"/>"), "unref.xml");
+    EXPECT_NE(msg.find("unref.xml:4:"), std::string::npos) << msg;
+    EXPECT_NE(msg.find("attached to no shape"), std::string::npos) << msg;
+}

@@ -3,6 +3,7 @@
 
 #include <cmath>
 #include <cstdlib>
+#include <set>
 
 #include <fmt/core.h>
 #include "neepp/loader/factories.h"
@@ -102,10 +103,19 @@ std::unique_ptr<Scene> read_scene(const std::string &path, const std::map<std::s
     scene->source_path = path;
     loader::Factories factories;
     bool have_sensor = false;
+    // Elements that shapes hold (an area emitter may be declared at the top level and <ref>'d by a shape).
+    std::set<const XmlNode *> in_shapes;
+    for (const auto &node : root->children)
+        if (node->tag == "shape")
+            for (const auto &child : node->children) in_shapes.insert(child.get());
     for (const auto &node : root->children) attempt([&] {  // when checking, a broken element is left out
         const std::string &tag = node->tag;
         if (tag == "shape") {
             factories.shape(*node, *scene);
+        } else if (tag == "emitter" && node->type == "area") {
+            // Made by the shapes that <ref> it, each its own light, as in Mitsuba.
+            if (!in_shapes.count(node.get()))
+                throw node->error("this 'area' emitter is attached to no shape (nest it in a <shape>, or <ref> it from one)");
         } else if (tag == "emitter") {
             factories.emitter(*node, *scene);
         } else if (tag == "sensor") {
