@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 #include "common/chi2.h"
 #include "neepp/lights/area_light.h"
+#include "neepp/lights/directional_light.h"
 #include "neepp/lights/environment_light.h"
 #include "neepp/lights/spot_light.h"
 #include "neepp/math/frame.h"
@@ -176,4 +177,36 @@ TEST(LightEmission, SpotLightEmitsIntoItsConeWithItsFalloff) {
     EXPECT_TRUE(ds.delta);
     EXPECT_NEAR(radiance.x, 3.f * 0.5f / 4.f, 1e-3f);
     EXPECT_THROW(tilted_spot(20.f, 20.f), std::invalid_argument);
+}
+
+// Mitsuba's directional light: every emitted ray travels along its direction, from a disk across the
+// scene's bounding sphere, and the rays carry irradiance × the disk's area; seen from a point, a delta
+// toward the light bringing the irradiance.
+TEST(LightEmission, DirectionalLightEmitsParallelRaysAcrossTheScene) {
+    DirectionalLight light(Vec3(0.5f, -1.f, -0.3f), Color(2.f, 1.8f, 1.5f));
+    BBox b;
+    b.expand(Vec3(-1, 0, -2));
+    b.expand(Vec3(2, 3, 1));
+    light.prepare(b);
+    const Vec3 travel = normalize(Vec3(0.5f, -1.f, -0.3f));
+    PCG32 rng(5, 9);
+    double flux = 0;
+    const int n = 100000;
+    for (int i = 0; i < n; ++i) {
+        const EmissionSample es = light.sample_emission(rng.next_2d(), rng.next_2d());
+        ASSERT_TRUE(es.valid());
+        ASSERT_NEAR(dot(es.ray.d, travel), 1.f, 1e-5f);
+        const EmissionDensity d = light.pdf_emission(es.p, es.n, es.ns, es.ray.d);
+        ASSERT_NEAR(d.pos, es.pdf_pos, 1e-6f * es.pdf_pos);
+        flux += luminance(es.radiance) / (es.pdf_pos * es.pdf_dir);
+    }
+    EXPECT_NEAR(flux / n, luminance(light.power()), 1e-4 * luminance(light.power()));
+    Color radiance;
+    const DirectionSample ds = light.sample_direction(Vec3(0.3f, 1.f, 0.f), Vec2(0.1f, 0.9f), radiance);
+    EXPECT_TRUE(ds.delta && light.is_delta() && light.is_infinite());
+    EXPECT_NEAR(dot(ds.d, -travel), 1.f, 1e-6f);
+    EXPECT_EQ(ds.dist, kInfinity);
+    EXPECT_FLOAT_EQ(radiance.x, 2.f);
+    EXPECT_EQ(light.eval_environment(-travel), Color(0.f));  // nothing can hit a delta
+    EXPECT_THROW(DirectionalLight(Vec3(0.f), Color(1.f)), std::invalid_argument);
 }

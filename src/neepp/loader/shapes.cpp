@@ -5,6 +5,7 @@
 #include "neepp/io/ply_reader.h"
 #include "neepp/lights/area_light.h"
 #include "neepp/lights/environment_light.h"
+#include "neepp/lights/directional_light.h"
 #include "neepp/lights/spot_light.h"
 #include "neepp/math/frame.h"
 #include "neepp/loader/factories.h"
@@ -256,6 +257,16 @@ void Factories::emitter(const XmlNode &node, Scene &scene) {
     } else if (t == "point") {
         Vec3 pos = node.get_vector("position", node.get_transform("to_world").point(Vec3(0.f)));
         scene.add_light(std::make_unique<PointLight>(pos, node.get_rgb("intensity", Color(1.f))));
+    } else if (t == "directional") {
+        if (node.has("direction") && node.has("to_world"))
+            throw node.error("give a directional light 'direction' or 'to_world', not both");
+        const Vec3 travel = node.has("direction") ? node.get_vector("direction")
+                                                  : node.get_transform("to_world").vector(Vec3(0, 0, 1));
+        try {
+            scene.add_light(std::make_unique<DirectionalLight>(travel, node.get_rgb("irradiance", Color(1.f))));
+        } catch (const std::invalid_argument &e) {
+            throw node.error(e.what());
+        }
     } else if (t == "spot") {
         for (const auto &child : node.children)
             if (child->name == "texture" || child->tag == "texture") throw child->error("a spot light's projected texture is not supported");

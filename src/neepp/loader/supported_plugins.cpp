@@ -10,7 +10,7 @@ const std::vector<std::pair<std::string, std::vector<std::string>>> &supported_p
         {"bsdf", {"diffuse", "twosided", "mask", "bumpmap", "conductor", "roughconductor", "plastic", "roughplastic",
                   "dielectric", "thindielectric"}},
         {"texture", {"bitmap", "checkerboard"}},
-        {"emitter", {"area", "envmap", "constant", "point", "spot"}},
+        {"emitter", {"area", "envmap", "constant", "point", "spot", "directional"}},
         {"sensor", {"perspective"}},
         {"film", {"hdrfilm"}},
         {"rfilter", {"box", "tent", "gaussian"}},
