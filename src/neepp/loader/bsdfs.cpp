@@ -92,7 +92,9 @@ BSDFPtr Factories::create_bsdf(const XmlNode &node) {
         auto kids = nested(1, 1);
         auto tex = node.children_with_tag("texture");
         if (tex.size() != 1) throw node.error("needs exactly one nested <texture> (the height map)");
-        b = std::make_shared<BumpMapBSDF>(texture(*tex[0]), node.get_float("scale", 1.f), bsdf(*kids[0]));
+        b = std::make_shared<BumpMapBSDF>(texture(*tex[0]), node.get_float("scale", 1.f), bsdf(*kids[0]),
+                                          node.get_bool("flip_invalid_normals", true),
+                                          node.get_bool("use_shadowing_function", true));
     } else if (t == "conductor") {
         auto [eta, k] = conductor_ior(*this, node);
         b = std::make_shared<ConductorBSDF>(eta, k, texture_param_or_null(node, "specular_reflectance"));
