@@ -7,23 +7,18 @@ rules as path tracing (the flip decided toward the camera, the shadowing and the
 light), so all three estimate one image."""
 from __future__ import annotations
 
-import subprocess
-
 import numpy as np
 import pytest
 
-from neepp_tools import REPO_ROOT, exr, metrics, runner
+from mitsuba_compare import mitsuba_render, neepp_agrees, sensor
+from neepp_tools import REPO_ROOT, exr
 
 OUT = REPO_ROOT / ".cache" / "test_mitsuba_bumpmap"
 
 SCENE = """<scene version="3.0.0">
   <default name="spp" value="64"/>
   <integrator type="path"><integer name="max_depth" value="4"/></integrator>
-  <sensor type="perspective"><float name="fov" value="45"/>
-    <transform name="to_world"><lookat origin="0,2.5,2.5" target="0,0,0" up="0,1,0"/></transform>
-    <sampler type="independent"><integer name="sample_count" value="$spp"/></sampler>
-    <film type="hdrfilm"><integer name="width" value="48"/><integer name="height" value="36"/><rfilter type="box"/></film>
-  </sensor>
+  @SENSOR@
   <shape type="rectangle"><transform name="to_world"><scale value="1.5"/><rotate x="1" angle="-90"/></transform>
     <bsdf type="bumpmap">
       <texture name="map" type="bitmap"><string name="filename" value="height.exr"/><boolean name="raw" value="true"/></texture>
@@ -46,29 +41,11 @@ def scene_and_reference(request, tmp_path_factory):
     height = (np.sin(x)[None, :] * np.cos(x)[:, None]).astype(np.float32) * 0.5 + 0.5
     exr.write_exr(folder / "height.exr", np.repeat(height[..., None], 3, 2))
     xml = folder / f"{request.param}.xml"
-    xml.write_text(SCENE.replace("@FLAGS@", FLAGS[request.param]))
-    out = OUT / f"mitsuba_{request.param}.exr"
-    OUT.mkdir(parents=True, exist_ok=True)
-    code = ("import os, mitsuba as mi; mi.set_variant('scalar_rgb'); "
-            f"img = mi.render(mi.load_file({str(xml)!r}), spp=2048, seed=1); "
-            f"mi.Bitmap(img).write({str(out)!r}); os._exit(0)")
-    subprocess.run([runner.mitsuba_python(), "-c", code], check=True, timeout=600)
-    return xml, exr.read_exr(out)[..., :3]
+    xml.write_text(SCENE.replace("@FLAGS@", FLAGS[request.param]).replace("@SENSOR@", sensor(45, "0,2.5,2.5", "0,0,0")))
+    return xml, mitsuba_render(xml, OUT / f"mitsuba_{request.param}.exr", spp=2048, seed=1)
 
 
 @pytest.mark.parametrize("integrator", ["path", "bdpt", "light"])
 def test_bump_maps_shade_as_in_mitsuba(integrator, scene_and_reference, neepp_bin):
     xml, ref = scene_and_reference
-    r = runner.run_neepp(xml, OUT / f"neepp_{xml.stem}_{integrator}.exr", spp=1024, seed=3, binary=neepp_bin,
-                         integrator=integrator)
-    img = r.image[..., :3]
-    m, mr = metrics.image_mean(img), metrics.image_mean(ref)
-    se = metrics.mean_stderr(img, ref, block=4)
-    assert abs(m - mr) < 4 * se + 0.01 * mr, (integrator, m, mr, se)
-    h, w = img.shape[0] // 3, img.shape[1] // 3
-    for i in range(3):
-        for j in range(3):
-            a, b = img[i * h:(i + 1) * h, j * w:(j + 1) * w], ref[i * h:(i + 1) * h, j * w:(j + 1) * w]
-            s = metrics.mean_stderr(a, b, block=4)
-            assert abs(metrics.image_mean(a) - metrics.image_mean(b)) < 4 * s + 0.02 * metrics.image_mean(b) + 1e-4, \
-                (integrator, i, j, metrics.image_mean(a), metrics.image_mean(b), s)
+    neepp_agrees(xml, ref, integrator, 1024, neepp_bin, OUT)

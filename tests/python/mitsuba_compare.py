@@ -1,0 +1,50 @@
+"""Shared by the tests that render a small scene of the project's own with Mitsuba 3 and with neepp and
+compare the images: Mitsuba's render (scalar_rgb, no LLVM needed) and the agreement test (the mean within
+a relative tolerance plus 4 standard errors, and each of 3 x 3 regions within a wider one)."""
+from __future__ import annotations
+
+import subprocess
+
+from neepp_tools import exr, metrics, runner
+
+# The camera and film both test scenes use: 48 x 36 pixels, box filter, the sample count as $spp.
+SENSOR = """<sensor type="perspective"><float name="fov" value="@FOV@"/>
+    <transform name="to_world"><lookat origin="@ORIGIN@" target="@TARGET@" up="0,1,0"/></transform>
+    <sampler type="independent"><integer name="sample_count" value="$spp"/></sampler>
+    <film type="hdrfilm"><integer name="width" value="48"/><integer name="height" value="36"/><rfilter type="box"/></film>
+  </sensor>"""
+
+
+def sensor(fov: float, origin: str, target: str) -> str:
+    return SENSOR.replace("@FOV@", str(fov)).replace("@ORIGIN@", origin).replace("@TARGET@", target)
+
+
+def mitsuba_render(xml, out, spp: int, seed: int):
+    """Mitsuba 3's image of the scene file (RGB)."""
+    out.parent.mkdir(parents=True, exist_ok=True)
+    code = ("import os, mitsuba as mi; mi.set_variant('scalar_rgb'); "
+            f"img = mi.render(mi.load_file({str(xml)!r}), spp={spp}, seed={seed}); "
+            f"mi.Bitmap(img).write({str(out)!r}); os._exit(0)")
+    subprocess.run([runner.mitsuba_python(), "-c", code], check=True, timeout=600)
+    return exr.read_exr(out)[..., :3]
+
+
+def assert_agrees(img, ref, what, mean_tol: float = 0.01, region_tol: float = 0.02):
+    img, ref = img[..., :3], ref[..., :3]
+    m, mr = metrics.image_mean(img), metrics.image_mean(ref)
+    se = metrics.mean_stderr(img, ref, block=4)
+    assert abs(m - mr) < 4 * se + mean_tol * mr, (what, m, mr, se)
+    h, w = img.shape[0] // 3, img.shape[1] // 3
+    for i in range(3):
+        for j in range(3):
+            a, b = img[i * h:(i + 1) * h, j * w:(j + 1) * w], ref[i * h:(i + 1) * h, j * w:(j + 1) * w]
+            ma, mb, s = metrics.image_mean(a), metrics.image_mean(b), metrics.mean_stderr(a, b, block=4)
+            assert abs(ma - mb) < 4 * s + region_tol * mb + 1e-4, (what, i, j, ma, mb, s)
+
+
+def neepp_agrees(xml, ref, integrator: str, spp: int, neepp_bin, out_dir) -> None:
+    """neepp's render of the scene file with the integrator agrees with Mitsuba's image (assert_agrees)."""
+    r = runner.run_neepp(xml, out_dir / f"neepp_{xml.stem}_{integrator}.exr", spp=spp, seed=3, binary=neepp_bin,
+                         integrator=integrator)
+    assert (r.image == r.image).all(), "NaN in the image"
+    assert_agrees(r.image, ref, (xml.stem, integrator))
