@@ -5,6 +5,7 @@
 #include <memory>
 #include "neepp/io/xml_tree.h"
 #include "neepp/materials/bsdf.h"
+#include "neepp/materials/principled.h"
 #include "neepp/scene/scene.h"
 
 namespace neepp::loader {
@@ -23,6 +24,8 @@ public:
 
 private:
     BSDFPtr create_bsdf(const XmlNode &node);
+    TexturePtr principled_lobe_param(const XmlNode &node, const std::string &name);
+    PrincipledParams principled_params(const XmlNode &node);
     std::map<const XmlNode *, TexturePtr> textures_;
     std::map<const XmlNode *, BSDFPtr> bsdfs_;
     BSDFPtr default_bsdf_;
