@@ -121,6 +121,20 @@ TEST(SceneLoader, PrincipledLobesFollowMitsubasPresenceRule) {
     EXPECT_NEAR(textured->eta(), principled_eta_from_specular(1e-3f), 1e-6f);
 }
 
+// Mitsuba's default BSDF is diffuse 0.5, except on an emitter, where it is black: a light without a BSDF
+// reflects nothing.
+TEST(SceneLoader, DefaultBsdfIsBlackOnEmitters) {
+    std::string path = write_temp_scene(scene_with(R"(
+<shape type="rectangle"><emitter type="area"><rgb name="radiance" value="1"/></emitter></shape>
+<shape type="sphere"/>)"));
+    auto scene = load_scene(path);
+    SurfaceInteraction si;
+    const Vec3 up(0.f, 0.f, 1.f);
+    const BSDFContext ctx;
+    EXPECT_TRUE(is_black(scene->shapes().at(0)->bsdf->eval(ctx, si, up, up)));
+    EXPECT_NEAR(scene->shapes().at(1)->bsdf->eval(ctx, si, up, up).x, 0.5f * kInvPi, 1e-6f);
+}
+
 TEST(SceneErrors, UnknownIntegratorAndOptionsAreRejected) {
     EXPECT_THROW(make_integrator("bidir-magic", Options()), std::invalid_argument);
     EXPECT_THROW(make_integrator("path", Options(OptionMap{{"max_dpeth", "3"}})), std::invalid_argument);

@@ -100,6 +100,11 @@ BSDFPtr Factories::default_bsdf() {
     return default_bsdf_;
 }
 
+BSDFPtr Factories::black_bsdf() {
+    if (!black_bsdf_) black_bsdf_ = std::make_shared<DiffuseBSDF>(constant_texture(0.f));
+    return black_bsdf_;
+}
+
 BSDFPtr Factories::bsdf(const XmlNode &node) {
     if (auto it = bsdfs_.find(&node); it != bsdfs_.end()) return it->second;
     if (node.tag != "bsdf") throw node.error("expected a <bsdf>, found <" + node.tag + ">");
