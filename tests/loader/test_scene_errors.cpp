@@ -3,6 +3,7 @@
 #include <fstream>
 #include "neepp/io/scene_error.h"
 #include "neepp/materials/principled.h"
+#include "neepp/materials/principledthin.h"
 #include "test_scenes.h"
 
 using namespace neepp;
@@ -119,6 +120,24 @@ TEST(SceneLoader, PrincipledLobesFollowMitsubasPresenceRule) {
     auto textured = load_bsdf(R"(<texture name="spec_trans" type="checkerboard"/><float name="specular" value="0"/>)");
     EXPECT_TRUE(textured->flags() & BSDFGlossyTransmission);
     EXPECT_NEAR(textured->eta(), principled_eta_from_specular(1e-3f), 1e-6f);
+}
+
+TEST(SceneLoader, PrincipledThinLoadsWithItsLobes) {
+    auto load_bsdf = [](const std::string &params) {
+        std::string path = write_temp_scene(scene_with(std::string(kLight) + "<shape type=\"rectangle\"><bsdf type=\"principledthin\">" +
+                                                       params + "</bsdf></shape>"));
+        return load_scene(path)->shapes().at(0)->bsdf;
+    };
+    auto leaf = load_bsdf(R"(<texture name="base_color" type="checkerboard"/><float name="diff_trans" value="1.2"/>
+        <float name="eta" value="1.3"/><float name="spec_trans" value="0"/>)");
+    ASSERT_TRUE(std::dynamic_pointer_cast<const PrincipledThinBSDF>(leaf));
+    EXPECT_TRUE(leaf->flags() & BSDFDiffuseTransmission);
+    EXPECT_FALSE(leaf->flags() & BSDFGlossyTransmission);
+    auto sheet = load_bsdf(R"(<float name="spec_trans" value="0.8"/><float name="anisotropic" value="0.2"/>)");
+    EXPECT_TRUE(sheet->flags() & BSDFGlossyTransmission);
+    EXPECT_FALSE(sheet->flags() & BSDFDiffuseTransmission);
+    EXPECT_TRUE(sheet->needs_tangents());
+    load_error(scene_with(std::string(kLight) + R"(<shape type="sphere"><bsdf type="principledthin"><float name="diffuse_reflectance_sampling_rate" value="0"/></bsdf></shape>)"));
 }
 
 // Mitsuba's default BSDF is diffuse 0.5, except on an emitter, where it is black: a light without a BSDF

@@ -1,4 +1,5 @@
-"""Writes principled_reference.inc: Mitsuba 3's own eval, pdf and sample of its `principled` BSDF for the
+"""Writes principled_reference.inc: Mitsuba 3's own eval, pdf and sample of its `principled` and
+`principledthin` BSDFs for the
 configurations that mitsuba_reference_test.cpp builds, in both transport modes, from outside and inside.
 
 Run with the Python that has the mitsuba package (scripts/test.sh installs it in .venv):
@@ -26,6 +27,19 @@ CONFIGS = {
 }
 
 
+# principledthin's: name -> parameters.
+THIN_CONFIGS = {
+    "principledthin_default": {},
+    "principledthin_trans": {"base_color": {"type": "rgb", "value": [0.7, 0.8, 0.9]}, "spec_trans": 0.7,
+                             "roughness": 0.35, "eta": 1.4, "spec_tint": 0.3},
+    "principledthin_difftrans_sheen": {"base_color": {"type": "rgb", "value": [0.3, 0.6, 0.2]}, "diff_trans": 1.2,
+                                       "sheen": 0.6, "sheen_tint": 0.5, "flatness": 0.4, "roughness": 0.6},
+    "principledthin_everything": {"base_color": {"type": "rgb", "value": [0.9, 0.5, 0.4]}, "spec_trans": 0.4,
+                                  "diff_trans": 0.6, "anisotropic": 0.5, "roughness": 0.3, "eta": 1.3,
+                                  "spec_tint": 0.2, "sheen": 0.3, "flatness": 0.2},
+}
+
+
 def unit(*v):
     return mi.ScalarVector3f(*v) / mi.ScalarFloat(sum(x * x for x in v) ** 0.5)
 
@@ -33,8 +47,10 @@ def unit(*v):
 WIS = [unit(0.3, -0.2, 0.8), unit(-0.7, 0.1, 0.3), unit(0.1, 0.05, -0.9), unit(0.6, -0.3, -0.45)]
 WOS = [unit(-0.2, 0.3, 0.9), unit(0.5, 0.5, 0.4), unit(-0.1, 0.0, 1.0), unit(0.3, -0.1, -0.95),
        unit(-0.5, 0.2, -0.7), unit(-0.9, 0.1, 0.2)]
-SAMPLES = [(0.05, (0.2, 0.7)), (0.2, (0.6, 0.1)), (0.35, (0.9, 0.95)), (0.5, (0.3, 0.4)),
-           (0.65, (0.75, 0.5)), (0.8, (0.1, 0.85)), (0.97, (0.45, 0.25))]
+SAMPLES = [(0.05, (0.2, 0.7)), (0.21, (0.6, 0.1)), (0.37, (0.9, 0.95)), (0.52, (0.3, 0.4)),
+           (0.66, (0.75, 0.5)), (0.81, (0.1, 0.85)), (0.97, (0.45, 0.25))]
+# u1 stays off the lobes' probability boundaries: on one (0.2 with principledthin_everything's
+# spec_trans 0.4) a one-ulp difference in a parameter's value picks the neighbouring lobe.
 
 
 def f(x):
@@ -52,8 +68,9 @@ def main():
     print("// Reference values generated with Mitsuba %s (pip package, scalar_rgb variant) by"
           % mi.__version__)
     print("// tests/materials/generate_principled_reference.py; one line per query.")
-    for name, params in CONFIGS.items():
-        bsdf = mi.load_dict({"type": "principled", **params})
+    for name, params in [*CONFIGS.items(), *THIN_CONFIGS.items()]:
+        plugin = "principledthin" if name in THIN_CONFIGS else "principled"
+        bsdf = mi.load_dict({"type": plugin, **params})
         for mode_name, mode in (("Radiance", mi.TransportMode.Radiance), ("Importance", mi.TransportMode.Importance)):
             ctx = mi.BSDFContext(mode)
             for wi in WIS:

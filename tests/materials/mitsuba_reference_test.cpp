@@ -12,6 +12,7 @@
 #include "neepp/materials/ior.h"
 #include "neepp/materials/plastic.h"
 #include "neepp/materials/principled.h"
+#include "neepp/materials/principledthin.h"
 #include "neepp/materials/roughconductor.h"
 #include "neepp/materials/roughplastic.h"
 #include "neepp/materials/thindielectric.h"
@@ -97,6 +98,24 @@ std::map<std::string, BSDFPtr> make_bsdfs() {
         p.spec_tint = tex(0.4f), p.anisotropic = tex(0.5f), p.sheen = tex(0.3f), p.sheen_tint = tex(0.2f);
         p.clearcoat = tex(0.6f), p.clearcoat_gloss = tex(0.3f), p.spec_trans = tex(0.4f);
     });
+    auto thin = [](Color base, const std::function<void(PrincipledThinParams &)> &set) {
+        PrincipledThinParams p;
+        p.base_color = tex(base);
+        set(p);
+        return std::make_shared<PrincipledThinBSDF>(p);
+    };
+    m["principledthin_default"] = thin(Color(0.5f), [](PrincipledThinParams &) {});
+    m["principledthin_trans"] = thin(Color(0.7f, 0.8f, 0.9f), [](PrincipledThinParams &p) {
+        p.spec_trans = tex(0.7f), p.roughness = tex(0.35f), p.eta = tex(1.4f), p.spec_tint = tex(0.3f);
+    });
+    m["principledthin_difftrans_sheen"] = thin(Color(0.3f, 0.6f, 0.2f), [](PrincipledThinParams &p) {
+        p.diff_trans = tex(1.2f), p.sheen = tex(0.6f), p.sheen_tint = tex(0.5f), p.flatness = tex(0.4f);
+        p.roughness = tex(0.6f);
+    });
+    m["principledthin_everything"] = thin(Color(0.9f, 0.5f, 0.4f), [](PrincipledThinParams &p) {
+        p.spec_trans = tex(0.4f), p.diff_trans = tex(0.6f), p.anisotropic = tex(0.5f), p.roughness = tex(0.3f);
+        p.eta = tex(1.3f), p.spec_tint = tex(0.2f), p.sheen = tex(0.3f), p.flatness = tex(0.2f);
+    });
     return m;
 }
 
@@ -127,7 +146,7 @@ TEST(MitsubaReference, EvalPdfAndSampleMatchMitsuba) {
             // fails, yet its pdf() returns the specular lobe's density: a density of nothing, which no
             // estimator uses (its value is 0). Here it is 0, as what sampling does.
             const bool density_of_nothing = q.wi.z < 0 && !(bsdf.flags() & BSDFTransmission) &&
-                                            std::string(q.bsdf).starts_with("principled");
+                                            std::string(q.bsdf).starts_with("principled_");
             expect_close(bsdf.pdf(ctx, si, q.wi, e->first), density_of_nothing ? 0.f : e->second.pdf, where + " pdf");
             ++evals;
         } else {

@@ -1,11 +1,12 @@
-"""Mitsuba 3's `principled` BSDF renders in neepp as in Mitsuba 3: a small room of the project's own
-with five principled objects (an anisotropic tinted metal box; a transmissive sphere with clearcoat and
-sheen; a sphere with a checkerboard base_color and roughness, flatness, sheen and `specular`; Mitsuba's
-documentation example with every lobe, spec_trans and anisotropy, on a sphere; a wall with no parameters at all), lit by a
-ceiling panel. neepp's `path` and `bdpt` (whose light subpaths evaluate the BSDF in importance mode, with
-no eta^2 through the transmissive spheres) against Mitsuba's `path` at the same size, depth and spp:
-image means within 1 %, and per 8x8 block a Sidak-corrected z-test of the difference passing on at least
-99 % of the blocks (metrics.block_agreement), so that one wrong object fails too.
+"""Mitsuba 3's `principled` and `principledthin` BSDFs render in neepp as in Mitsuba 3: a small room of
+the project's own with five principled objects (an anisotropic tinted metal box; a transmissive sphere
+with clearcoat and sheen; a sphere with a checkerboard base_color and roughness, flatness, sheen and
+`specular`; Mitsuba's documentation example, every lobe with spec_trans and anisotropy, on a sphere; a
+wall with no parameters at all) and a principledthin panel (diffuse and specular transmission, textured),
+lit by a ceiling panel. neepp's `path` and `bdpt` (whose light subpaths evaluate the BSDFs in importance
+mode, without eta^2 through the transmissive spheres) against Mitsuba's `path` at the same size, depth
+and spp: image means within 1 %, and per 8x8 block a Sidak-corrected z-test of the difference passing on
+at least 99 % of the blocks (metrics.block_agreement), so that one wrong object fails too.
 Renders go to .cache/test_principled_vs_mitsuba/; Mitsuba's is cached under .cache/mitsuba.
 """
 from __future__ import annotations
@@ -78,6 +79,18 @@ SCENE = """<scene version="3.0.0">
       <float name="spec_tint" value="0.4"/><float name="anisotropic" value="0.5"/><float name="sheen" value="0.3"/>
       <float name="sheen_tint" value="0.2"/><float name="clearcoat" value="0.6"/>
       <float name="clearcoat_gloss" value="0.3"/><float name="spec_trans" value="0.4"/>
+    </bsdf></shape>
+
+  <!-- principledthin: a leaf-like panel, light passing through it diffusely and specularly. -->
+  <shape type="rectangle">
+    <transform name="to_world"><scale x="0.35" y="0.28"/><rotate x="1" angle="-60"/><translate x="0.05" y="-0.7" z="0.35"/></transform>
+    <bsdf type="principledthin">
+      <texture name="base_color" type="checkerboard">
+        <rgb name="color0" value="0.3, 0.7, 0.2"/><rgb name="color1" value="0.9, 0.8, 0.3"/>
+        <transform name="to_uv"><scale x="3" y="3"/></transform>
+      </texture>
+      <float name="diff_trans" value="1.0"/><float name="spec_trans" value="0.5"/><float name="roughness" value="0.35"/>
+      <float name="eta" value="1.4"/><float name="sheen" value="0.3"/><float name="spec_tint" value="0.2"/>
     </bsdf></shape>
 </scene>
 """

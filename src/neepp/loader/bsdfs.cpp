@@ -8,6 +8,7 @@
 #include "neepp/materials/ior.h"
 #include "neepp/materials/plastic.h"
 #include "neepp/materials/principled.h"
+#include "neepp/materials/principledthin.h"
 #include "neepp/materials/roughconductor.h"
 #include "neepp/materials/roughplastic.h"
 #include "neepp/materials/thindielectric.h"
@@ -78,6 +79,30 @@ PrincipledParams Factories::principled_params(const XmlNode &node) {
         if (!(rate >= 0.f)) throw node.error("sampling rates must be non-negative");
     if (!(p.main_specular_sampling_rate > 0.f))
         throw node.error("'main_specular_sampling_rate' must be positive (the specular lobes would never be sampled)");
+    return p;
+}
+
+PrincipledThinParams Factories::principled_thin_params(const XmlNode &node) {
+    PrincipledThinParams p;
+    p.base_color = texture_param(node, "base_color", Color(0.5f));
+    p.roughness = texture_param(node, "roughness", Color(0.5f));
+    p.eta = texture_param(node, "eta", Color(1.5f));
+    p.anisotropic = principled_lobe_param(node, "anisotropic");
+    p.spec_trans = principled_lobe_param(node, "spec_trans");
+    p.spec_tint = principled_lobe_param(node, "spec_tint");
+    p.sheen = principled_lobe_param(node, "sheen");
+    p.sheen_tint = principled_lobe_param(node, "sheen_tint");
+    p.flatness = principled_lobe_param(node, "flatness");
+    p.diff_trans = principled_lobe_param(node, "diff_trans");
+    p.specular_reflectance_sampling_rate = node.get_float("specular_reflectance_sampling_rate", 1.f);
+    p.specular_transmittance_sampling_rate = node.get_float("specular_transmittance_sampling_rate", 1.f);
+    p.diffuse_reflectance_sampling_rate = node.get_float("diffuse_reflectance_sampling_rate", 1.f);
+    p.diffuse_transmittance_sampling_rate = node.get_float("diffuse_transmittance_sampling_rate", 1.f);
+    for (float rate : {p.specular_reflectance_sampling_rate, p.specular_transmittance_sampling_rate,
+                       p.diffuse_reflectance_sampling_rate, p.diffuse_transmittance_sampling_rate})
+        if (!(rate >= 0.f)) throw node.error("sampling rates must be non-negative");
+    if (!(p.diffuse_reflectance_sampling_rate > 0.f))
+        throw node.error("'diffuse_reflectance_sampling_rate' must be positive (the diffuse lobe would never be sampled)");
     return p;
 }
 
@@ -179,6 +204,8 @@ BSDFPtr Factories::create_bsdf(const XmlNode &node) {
         else b = std::make_shared<ThinDielectricBSDF>(int_ior, ext_ior, r, tr);
     } else if (t == "principled") {
         b = std::make_shared<PrincipledBSDF>(principled_params(node));
+    } else if (t == "principledthin") {
+        b = std::make_shared<PrincipledThinBSDF>(principled_thin_params(node));
     } else {
         throw node.error("unsupported BSDF type '" + t + "' (supported: " + supported_list("bsdf") + ")");
     }

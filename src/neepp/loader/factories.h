@@ -6,6 +6,7 @@
 #include "neepp/io/xml_tree.h"
 #include "neepp/materials/bsdf.h"
 #include "neepp/materials/principled.h"
+#include "neepp/materials/principledthin.h"
 #include "neepp/scene/scene.h"
 
 namespace neepp::loader {
@@ -27,6 +28,7 @@ private:
     BSDFPtr create_bsdf(const XmlNode &node);
     TexturePtr principled_lobe_param(const XmlNode &node, const std::string &name);
     PrincipledParams principled_params(const XmlNode &node);
+    PrincipledThinParams principled_thin_params(const XmlNode &node);
     std::map<const XmlNode *, TexturePtr> textures_;
     std::map<const XmlNode *, BSDFPtr> bsdfs_;
     BSDFPtr default_bsdf_, black_bsdf_;

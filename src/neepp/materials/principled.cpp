@@ -14,14 +14,6 @@ float eval_or_zero(const TexturePtr &t, const SurfaceInteraction &si) { return t
 
 float lerp(float a, float b, float t) { return a * (1.f - t) + b * t; }
 
-// base_color divided by its luminance: its hue at unit brightness (white when black).
-Color tint_color(const Color &base_color) {
-    float lum = luminance(base_color);
-    return lum > 0.f ? base_color / lum : Color(1.f);
-}
-
-float schlick_r0(float eta) { return sqr((eta - 1.f) / (eta + 1.f)); }
-
 // Clearcoat's shadowing: Smith GGX at a fixed alpha of 0.25, as Burley.
 const MicrofacetDistribution &clearcoat_shadowing() {
     static const MicrofacetDistribution d(MicrofacetType::GGX, 0.25f);
@@ -30,15 +22,47 @@ const MicrofacetDistribution &clearcoat_shadowing() {
 
 float clearcoat_alpha(float gloss) { return lerp(0.1f, 0.001f, gloss); }
 
-// Mitsuba's test that a microfacet normal m (pointing out of the surface) can carry wi to wo: both on
-// m's front as seen from wi's side for a reflection, wo behind it for a refraction.
+}  // namespace
+
+namespace principled {
+
+MicrofacetDistribution distribution(float roughness, float anisotropic) {
+    const float r2 = sqr(roughness), aspect = std::sqrt(1.f - 0.9f * anisotropic);
+    return MicrofacetDistribution(MicrofacetType::GGX, std::max(0.001f, r2 / aspect), std::max(0.001f, r2 * aspect));
+}
+
+Color tint_color(const Color &base_color) {
+    float lum = luminance(base_color);
+    return lum > 0.f ? base_color / lum : Color(1.f);
+}
+
 bool microfacet_compatible(const Vec3 &m, const Vec3 &wi, const Vec3 &wo, bool reflection) {
     const Vec3 m_wi = wi.z >= 0.f ? m : -m;
     const float wo_m = dot(wo, m_wi);
     return dot(wi, m_wi) > 0.f && (reflection ? wo_m > 0.f : wo_m < 0.f);
 }
 
-}  // namespace
+float diffuse_shape(float roughness, float abs_cos_i, float abs_cos_o, float cos_d, bool flatten, float flatness) {
+    const float fo = schlick_weight(abs_cos_o), fi = schlick_weight(abs_cos_i);
+    const float f_diffuse = (1.f - 0.5f * fi) * (1.f - 0.5f * fo);
+    const float rr = 2.f * roughness * sqr(cos_d);
+    const float shape = f_diffuse + rr * (fo + fi + fo * fi * (rr - 1.f));
+    if (!flatten) return shape;
+    const float fss90 = 0.5f * rr, fss = lerp(1.f, fss90, fo) * lerp(1.f, fss90, fi);
+    const float f_ss = 1.25f * (fss * (1.f / (abs_cos_o + abs_cos_i) - 0.5f) + 0.5f);
+    return lerp(shape, f_ss, flatness);
+}
+
+Color sheen_color(const Color &base_color, bool tinted, float sheen_tint) {
+    if (!tinted) return Color(1.f);
+    return Color(1.f - sheen_tint) + tint_color(base_color) * sheen_tint;
+}
+
+}  // namespace principled
+
+using principled::microfacet_compatible;
+using principled::schlick_r0;
+using principled::tint_color;
 
 float schlick_weight(float cos_theta) {
     const float m = std::clamp(1.f - cos_theta, 0.f, 1.f), m2 = m * m;
@@ -99,9 +123,7 @@ PrincipledBSDF::Local PrincipledBSDF::lookup(const SurfaceInteraction &si) const
 }
 
 MicrofacetDistribution PrincipledBSDF::specular_distribution(const Local &l) const {
-    // Disney's mapping: alpha = roughness^2, stretched along u and squeezed along v by the anisotropy.
-    const float r2 = sqr(l.roughness), aspect = std::sqrt(1.f - 0.9f * l.anisotropic);
-    return MicrofacetDistribution(MicrofacetType::GGX, std::max(0.001f, r2 / aspect), std::max(0.001f, r2 * aspect));
+    return principled::distribution(l.roughness, l.anisotropic);
 }
 
 PrincipledBSDF::LobeProbabilities PrincipledBSDF::lobe_probabilities(const Local &l, bool front_side,
@@ -199,25 +221,13 @@ BSDFEval PrincipledBSDF::eval_pdf(const BSDFContext &ctx, const SurfaceInteracti
     if (reflect && front) {
         r.pdf += prob.diffuse * square_to_cosine_hemisphere_pdf(wo);
         if (brdf > 0.f) {
-            const float abs_cos_i = std::abs(cos_i), abs_cos_o = std::abs(cos_o);
-            const float fo = schlick_weight(abs_cos_o), fi = schlick_weight(abs_cos_i);
-            const float cos_d = dot(wh, wo);
-            // Burley's diffuse with its retro-reflection, optionally flattened toward Hanrahan-Krueger.
-            const float f_diffuse = (1.f - 0.5f * fi) * (1.f - 0.5f * fo);
-            const float rr = 2.f * l.roughness * sqr(cos_d);
-            float shape = f_diffuse + rr * (fo + fi + fo * fi * (rr - 1.f));
-            if (p_.flatness) {
-                const float fss90 = 0.5f * rr, fss = lerp(1.f, fss90, fo) * lerp(1.f, fss90, fi);
-                const float f_ss = 1.25f * (fss * (1.f / (abs_cos_o + abs_cos_i) - 0.5f) + 0.5f);
-                shape = lerp(shape, f_ss, l.flatness);
-            }
+            const float abs_cos_o = std::abs(cos_o), cos_d = dot(wh, wo);
+            const float shape = principled::diffuse_shape(l.roughness, std::abs(cos_i), abs_cos_o, cos_d,
+                                                          p_.flatness != nullptr, l.flatness);
             r.f += l.base_color * (brdf * abs_cos_o * kInvPi * shape);
-            if (p_.sheen && l.sheen > 0.f && 1.f - l.metallic > 0.f) {
-                Color sheen_color(1.f);
-                if (p_.sheen_tint)
-                    sheen_color = Color(1.f - l.sheen_tint) + tint_color(l.base_color) * l.sheen_tint;
-                r.f += sheen_color * (l.sheen * (1.f - l.metallic) * schlick_weight(std::abs(cos_d)) * abs_cos_o);
-            }
+            if (p_.sheen && l.sheen > 0.f && 1.f - l.metallic > 0.f)
+                r.f += principled::sheen_color(l.base_color, p_.sheen_tint != nullptr, l.sheen_tint) *
+                       (l.sheen * (1.f - l.metallic) * schlick_weight(std::abs(cos_d)) * abs_cos_o);
         }
     }
     return r;

@@ -44,6 +44,26 @@ struct PrincipledParams {
 // Mitsuba's `specular` parameter as an IOR: the eta whose normal-incidence reflectance is 0.08 specular.
 inline float principled_eta_from_specular(float specular) { return 2.f / (1.f - std::sqrt(0.08f * specular)) - 1.f; }
 
+// The pieces that Mitsuba's principled and principledthin share.
+namespace principled {
+// Disney's roughness mapping: GGX with alpha = roughness^2, stretched along u and squeezed along v by the
+// anisotropy (sqrt(1 - 0.9 anisotropic)), alpha at least 0.001.
+MicrofacetDistribution distribution(float roughness, float anisotropic);
+// Normal-incidence reflectance of an interface of relative IOR eta.
+inline float schlick_r0(float eta) { return sqr((eta - 1.f) / (eta + 1.f)); }
+// base_color divided by its luminance: its hue at unit brightness (white when black).
+Color tint_color(const Color &base_color);
+// Mitsuba's test that a microfacet normal m (pointing out of the surface) can carry wi to wo: both on
+// m's front as seen from wi's side for a reflection, wo behind it for a refraction.
+bool microfacet_compatible(const Vec3 &m, const Vec3 &wi, const Vec3 &wo, bool reflection);
+// Burley's diffuse with retro-reflection, for |cos theta_i|, |cos theta_o| and cos theta_d = wh.wo, to be
+// multiplied by base_color / pi; with `flatten`, blended by `flatness` toward Hanrahan-Krueger's "fake
+// subsurface" term.
+float diffuse_shape(float roughness, float abs_cos_i, float abs_cos_o, float cos_d, bool flatten, float flatness);
+// The sheen's colour: white, or toward the base_color's hue by sheen_tint.
+Color sheen_color(const Color &base_color, bool tinted, float sheen_tint);
+}  // namespace principled
+
 // Schlick's approximation of the Fresnel reflectance with normal-incidence reflectance r0, for light arriving
 // at cosine cos_theta_i (negative: from inside) on an interface of relative IOR eta; arriving from the
 // denser side it uses the refracted cosine (1 under total internal reflection), as Mitsuba's calc_schlick.
