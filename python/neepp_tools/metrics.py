@@ -13,7 +13,8 @@ import numpy as np
 EPS = 0.01
 
 __all__ = ["EPS", "downsample", "relmse_map", "relmse", "relative_variance", "rmse", "mean_abs_rel_error",
-           "image_mean", "mean_stderr", "relmse_stderr", "all_metrics", "paired_ratios"]
+           "image_mean", "mean_stderr", "relmse_stderr", "block_z_scores", "block_agreement", "all_metrics",
+           "paired_ratios"]
 
 
 def _pair(img, ref):
@@ -85,6 +86,37 @@ def mean_stderr(img, ref, block: int = 8) -> float:
         return float(np.std(d) / np.sqrt(d.size))
     tiles = d[: hb * block, : wb * block].reshape(hb, block, wb, block).mean(axis=(1, 3))
     return float(np.std(tiles, ddof=1) / np.sqrt(tiles.size))
+
+
+def block_z_scores(a, b, block: int = 8) -> np.ndarray:
+    """Per block of block x block pixels: z of the mean of the per-pixel difference a - b (mean over the
+    channels), its variance from the block's own differences. Where both images estimate the same one, the
+    difference is noise of mean zero in every pixel (the image's structure cancels), so this tests
+    agreement locally."""
+    x, y = _pair(a, b)
+    d = x.mean(axis=2) - y.mean(axis=2)
+    h, w = (d.shape[0] // block) * block, (d.shape[1] // block) * block
+    blocks = d[:h, :w].reshape(h // block, block, w // block, block).transpose(0, 2, 1, 3).reshape(-1, block * block)
+    se = blocks.std(axis=1, ddof=1) / math.sqrt(block * block)
+    return np.where(se > 0, blocks.mean(axis=1) / np.maximum(se, 1e-30), 0.0)
+
+
+def block_agreement(a, b, block: int = 8, level: float = 0.01) -> tuple[float, float, int]:
+    """(fraction of blocks whose |z| is below the critical value, that value, the number of blocks): the
+    block_z_scores with a Sidak correction, so that all blocks together fail with probability `level`
+    when the images agree."""
+    z = block_z_scores(a, b, block)
+    alpha = 1 - (1 - level) ** (1 / len(z))
+    z_crit = math.sqrt(2) * _erfinv(1 - alpha)
+    return float(np.mean(np.abs(z) < z_crit)), z_crit, len(z)
+
+
+def _erfinv(y: float) -> float:
+    # Newton on erf, from a good start: precise enough for a critical value.
+    x = math.sqrt(-math.log((1 - y) / 2)) if y > 0.5 else 0.0
+    for _ in range(60):
+        x -= (math.erf(x) - y) / (2 / math.sqrt(math.pi) * math.exp(-x * x))
+    return x
 
 
 def relmse_stderr(img, ref, block: int = 8, eps: float = EPS) -> float:

@@ -2,6 +2,8 @@
 #include <gtest/gtest.h>
 #include <fstream>
 #include "neepp/io/scene_error.h"
+#include "neepp/materials/principled.h"
+#include "neepp/materials/principledthin.h"
 #include "test_scenes.h"
 
 using namespace neepp;
@@ -84,6 +86,72 @@ TEST(SceneErrors, BadParameterValues) {
     load_error(scene_with(std::string(kLight) + R"(<shape type="sphere"><bsdf type="roughconductor"><string name="material" value="Unobtainium"/></bsdf></shape>)"));
     load_error(scene_with(std::string(kLight) + R"(<shape type="sphere"><bsdf type="dielectric"><string name="int_ior" value="glassy"/></bsdf></shape>)"));
     load_error(scene_with(std::string(kLight) + R"(<shape type="sphere"><ref id="nothing"/></shape>)"));
+}
+
+TEST(SceneErrors, PrincipledTakesEitherEtaOrSpecular) {
+    std::string msg = load_error(scene_with(std::string(kLight) + R"(
+<shape type="sphere"><bsdf type="principled"><float name="eta" value="1.4"/><float name="specular" value="0.3"/></bsdf></shape>)"));
+    EXPECT_NE(msg.find(":4:"), std::string::npos) << msg;
+    EXPECT_NE(msg.find("either 'eta' or 'specular'"), std::string::npos) << msg;
+    load_error(scene_with(std::string(kLight) + R"(<shape type="sphere"><bsdf type="principled"><float name="eta" value="-1"/></bsdf></shape>)"));
+    load_error(scene_with(std::string(kLight) + R"(<shape type="sphere"><bsdf type="principled"><float name="main_specular_sampling_rate" value="0"/></bsdf></shape>)"));
+}
+
+// Mitsuba's rule for principled's lobes: a parameter left out, or given as the float 0, switches its lobe
+// off; given (a texture, an rgb, a non-zero float) it is on. spec_trans decides whether the BSDF has a
+// transmission lobe, and with it eta = 1 (or specular = 0) moves off 1 as Mitsuba does.
+TEST(SceneLoader, PrincipledLobesFollowMitsubasPresenceRule) {
+    auto load_bsdf = [](const std::string &params) {
+        std::string path = write_temp_scene(scene_with(std::string(kLight) + "<shape type=\"sphere\"><bsdf type=\"principled\">" +
+                                                       params + "</bsdf></shape>"));
+        auto scene = load_scene(path);
+        return std::dynamic_pointer_cast<const PrincipledBSDF>(scene->shapes().at(0)->bsdf);
+    };
+    auto opaque = load_bsdf(R"(<float name="spec_trans" value="0"/><float name="anisotropic" value="0"/>)");
+    ASSERT_TRUE(opaque);
+    EXPECT_FALSE(opaque->flags() & BSDFTransmission);
+    EXPECT_FALSE(opaque->needs_tangents());
+    EXPECT_FLOAT_EQ(opaque->eta(), 1.5f);  // specular 0.5
+    auto glass = load_bsdf(R"(<float name="spec_trans" value="0.5"/><float name="eta" value="1"/><float name="anisotropic" value="0.3"/>)");
+    EXPECT_TRUE(glass->flags() & BSDFGlossyTransmission);
+    EXPECT_TRUE(glass->needs_tangents());
+    EXPECT_FLOAT_EQ(glass->eta(), 1.001f);
+    EXPECT_FLOAT_EQ(load_bsdf(R"(<float name="eta" value="1"/>)")->eta(), 1.f);
+    auto textured = load_bsdf(R"(<texture name="spec_trans" type="checkerboard"/><float name="specular" value="0"/>)");
+    EXPECT_TRUE(textured->flags() & BSDFGlossyTransmission);
+    EXPECT_NEAR(textured->eta(), principled_eta_from_specular(1e-3f), 1e-6f);
+}
+
+TEST(SceneLoader, PrincipledThinLoadsWithItsLobes) {
+    auto load_bsdf = [](const std::string &params) {
+        std::string path = write_temp_scene(scene_with(std::string(kLight) + "<shape type=\"rectangle\"><bsdf type=\"principledthin\">" +
+                                                       params + "</bsdf></shape>"));
+        return load_scene(path)->shapes().at(0)->bsdf;
+    };
+    auto leaf = load_bsdf(R"(<texture name="base_color" type="checkerboard"/><float name="diff_trans" value="1.2"/>
+        <float name="eta" value="1.3"/><float name="spec_trans" value="0"/>)");
+    ASSERT_TRUE(std::dynamic_pointer_cast<const PrincipledThinBSDF>(leaf));
+    EXPECT_TRUE(leaf->flags() & BSDFDiffuseTransmission);
+    EXPECT_FALSE(leaf->flags() & BSDFGlossyTransmission);
+    auto sheet = load_bsdf(R"(<float name="spec_trans" value="0.8"/><float name="anisotropic" value="0.2"/>)");
+    EXPECT_TRUE(sheet->flags() & BSDFGlossyTransmission);
+    EXPECT_FALSE(sheet->flags() & BSDFDiffuseTransmission);
+    EXPECT_TRUE(sheet->needs_tangents());
+    load_error(scene_with(std::string(kLight) + R"(<shape type="sphere"><bsdf type="principledthin"><float name="diffuse_reflectance_sampling_rate" value="0"/></bsdf></shape>)"));
+}
+
+// Mitsuba's default BSDF is diffuse 0.5, except on an emitter, where it is black: a light without a BSDF
+// reflects nothing.
+TEST(SceneLoader, DefaultBsdfIsBlackOnEmitters) {
+    std::string path = write_temp_scene(scene_with(R"(
+<shape type="rectangle"><emitter type="area"><rgb name="radiance" value="1"/></emitter></shape>
+<shape type="sphere"/>)"));
+    auto scene = load_scene(path);
+    SurfaceInteraction si;
+    const Vec3 up(0.f, 0.f, 1.f);
+    const BSDFContext ctx;
+    EXPECT_TRUE(is_black(scene->shapes().at(0)->bsdf->eval(ctx, si, up, up)));
+    EXPECT_NEAR(scene->shapes().at(1)->bsdf->eval(ctx, si, up, up).x, 0.5f * kInvPi, 1e-6f);
 }
 
 TEST(SceneErrors, UnknownIntegratorAndOptionsAreRejected) {

@@ -11,9 +11,6 @@ Renders go to .cache/test_bdpt_vs_mitsuba/; Mitsuba's are cached under .cache/mi
 """
 from __future__ import annotations
 
-import math
-
-import numpy as np
 import pytest
 
 from neepp_tools import REFERENCES, REPO_ROOT, exr, metrics, runner
@@ -71,17 +68,6 @@ def test_light_tracing_mean_matches_reference(scene, scenes_dir, neepp_bin):
     assert abs(m / mr - 1) < MEAN_TOL, msg
 
 
-def block_z_test(a, b, block=8):
-    """Per block of block x block pixels: z of the mean of the per-pixel difference a - b (luminance), its
-    variance from the block's own differences. Where both images estimate the same one, the difference is
-    noise of mean zero in every pixel (the image's structure cancels), so this tests agreement locally."""
-    d = a.mean(axis=2) - b.mean(axis=2)
-    h, w = (d.shape[0] // block) * block, (d.shape[1] // block) * block
-    blocks = d[:h, :w].reshape(h // block, block, w // block, block).transpose(0, 2, 1, 3).reshape(-1, block * block)
-    se = blocks.std(axis=1, ddof=1) / math.sqrt(block * block)
-    return np.where(se > 0, blocks.mean(axis=1) / np.maximum(se, 1e-30), 0.0)
-
-
 @pytest.mark.parametrize("scene", list(LIGHT_SPP))
 def test_light_tracing_matches_mitsuba_ptracer(scene, scenes_dir, neepp_bin, mitsuba_variant):
     w, h = size(scene)
@@ -90,21 +76,11 @@ def test_light_tracing_matches_mitsuba_ptracer(scene, scenes_dir, neepp_bin, mit
     theirs = runner.run_mitsuba(scenes_dir / scene / "scene.xml", variant=mitsuba_variant, resx=w, resy=h, spp=spp,
                                 max_depth=MAX_DEPTH, seed=3, integrator="ptracer", timeout=900, cache=True)
     m, mm = metrics.image_mean(ours.image), metrics.image_mean(theirs.image)
-    z = block_z_test(ours.image, theirs.image)
-    # Sidak: per-block level so that all blocks together fail with probability 1 % when the images agree.
-    alpha = 1 - (1 - 0.01) ** (1 / len(z))
-    z_crit = math.sqrt(2) * _erfinv(1 - alpha)
-    passed = float(np.mean(np.abs(z) < z_crit))
+    # Sidak-corrected per-block z-test: all blocks together fail with probability 1 % when the images agree.
+    passed, z_crit, n = metrics.block_agreement(ours.image, theirs.image)
     msg = (f"{scene} light vs Mitsuba ptracer, {w}x{h}, {spp} spp: means {m:.5g} / {mm:.5g} ({m / mm - 1:+.3%}); "
-           f"{passed:.2%} of {len(z)} blocks within |z| < {z_crit:.2f}")
+           f"{passed:.2%} of {n} blocks within |z| < {z_crit:.2f}")
     print(msg)
     assert abs(m / mm - 1) < MEAN_TOL, msg
     assert passed >= 0.99, msg
 
-
-def _erfinv(y: float) -> float:
-    # Newton on erf, from a good start: precise enough for a critical value.
-    x = math.sqrt(-math.log((1 - y) / 2)) if y > 0.5 else 0.0
-    for _ in range(60):
-        x -= (math.erf(x) - y) / (2 / math.sqrt(math.pi) * math.exp(-x * x))
-    return x

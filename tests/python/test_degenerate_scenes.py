@@ -60,6 +60,21 @@ CASES = {
     "roughconductor_anisotropic_0": scene(FLOOR, LIGHT, sphere(
         "<bsdf type='roughconductor'><float name='alpha_u' value='0'/><float name='alpha_v' value='0.3'/></bsdf>")),
     "roughplastic_alpha_0": scene(FLOOR, LIGHT, sphere("<bsdf type='roughplastic'><float name='alpha' value='0'/></bsdf>")),
+    # principled at the ends of its ranges: a mirror-smooth full anisotropy, eta 1 through spec_trans (moved
+    # to 1.001), specular 0, the glossiest clearcoat on a black base; principledthin of eta 1 (its
+    # transmission's roughness then scales to 0.3) and all diffuse transmission.
+    "principled_extremes": scene(FLOOR, LIGHT, sphere(
+        "<bsdf type='principled'><float name='roughness' value='0'/><float name='anisotropic' value='1'/>"
+        "<float name='spec_trans' value='1'/><float name='eta' value='1'/><float name='sheen' value='1'/></bsdf>"),
+        "<shape type='cube'><transform name='to_world'><scale value='0.3'/><translate x='1' y='0.3'/></transform>"
+        "<bsdf type='principled'><rgb name='base_color' value='0'/><float name='specular' value='0'/>"
+        "<float name='metallic' value='1'/><float name='clearcoat' value='1'/><float name='clearcoat_gloss' value='1'/>"
+        "<float name='flatness' value='1'/><float name='roughness' value='1'/></bsdf></shape>"),
+    "principledthin_extremes": scene(FLOOR, LIGHT, sphere(
+        "<bsdf type='principledthin'><float name='roughness' value='0'/><float name='eta' value='1'/>"
+        "<float name='spec_trans' value='1'/><float name='anisotropic' value='1'/></bsdf>"),
+        "<shape type='cube'><transform name='to_world'><scale value='0.3'/><translate x='1' y='0.3'/></transform>"
+        "<bsdf type='principledthin'><float name='diff_trans' value='2'/><float name='flatness' value='1'/></bsdf></shape>"),
     "dielectric_ior_1": scene(FLOOR, LIGHT, sphere(
         "<bsdf type='dielectric'><float name='int_ior' value='1'/><float name='ext_ior' value='1'/></bsdf>")),
     "thindielectric_ior_1": scene(FLOOR, LIGHT, sphere(

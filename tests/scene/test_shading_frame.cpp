@@ -86,3 +86,32 @@ TEST(ShadingFrame, SameNormalAndUvWithOrWithoutTangents) {
 }
 
 }  // namespace
+
+namespace {
+
+// A sphere's frame follows dp/du (the azimuth direction) where its BSDF reads tangents, as Mitsuba's does.
+TEST(ShadingFrame, SphereFrameFollowsDpDuWhenTangentsAreRead) {
+    TexturePtr a = constant_texture(0.2f), b = constant_texture(0.05f);
+    Shape s;
+    s.kind = Shape::Kind::Sphere;
+    s.center = Vec3(0.5f, -0.2f, 1.f);
+    s.radius = 2.f;
+    s.bsdf = std::make_shared<RoughConductorBSDF>(MicrofacetType::GGX, a, b, constant_texture(Color(0.2f)),
+                                                  constant_texture(Color(3.f)));
+    s.finalize();
+    ASSERT_TRUE(s.tangents);
+    PCG32 rng(5, 7);
+    for (int k = 0; k < 100; ++k) {
+        const Vec2 u = rng.next_2d();
+        const float z = 1.f - 2.f * u.y, r = std::sqrt(std::max(0.f, 1.f - z * z)), phi = 2.f * kPi * u.x;
+        const Vec3 dir(r * std::cos(phi), r * std::sin(phi), z);
+        const Ray ray{s.center + dir * 5.f, -dir, 0.f, kInfinity};
+        SurfaceInteraction si;
+        s.fill_interaction(0, 0.f, 0.f, ray, 3.f, si);
+        expect_orthonormal(si.sh_frame);
+        EXPECT_NEAR(norm(si.sh_frame.n - dir), 0.f, 1e-5f);
+        EXPECT_NEAR(norm(si.sh_frame.s - normalize(Vec3(-dir.y, dir.x, 0.f))), 0.f, 1e-4f);
+    }
+}
+
+}  // namespace

@@ -1,3 +1,4 @@
+#include <cmath>
 #include <optional>
 #include "neepp/loader/supported_plugins.h"
 #include "neepp/loader/factories.h"
@@ -6,6 +7,8 @@
 #include "neepp/materials/diffuse.h"
 #include "neepp/materials/ior.h"
 #include "neepp/materials/plastic.h"
+#include "neepp/materials/principled.h"
+#include "neepp/materials/principledthin.h"
 #include "neepp/materials/roughconductor.h"
 #include "neepp/materials/roughplastic.h"
 #include "neepp/materials/thindielectric.h"
@@ -35,6 +38,74 @@ std::pair<TexturePtr, TexturePtr> conductor_ior(Factories &f, const XmlNode &nod
 
 }  // namespace
 
+// Mitsuba's principled: a lobe parameter the scene leaves out, or gives as the float 0, switches its lobe
+// off (null); anything else, a texture included, switches it on.
+TexturePtr Factories::principled_lobe_param(const XmlNode &node, const std::string &name) {
+    if (node.has(name) && node.props.at(name).kind == XmlProperty::Kind::Float && node.get_float(name) == 0.f)
+        return nullptr;
+    return texture_param_or_null(node, name);
+}
+
+PrincipledParams Factories::principled_params(const XmlNode &node) {
+    PrincipledParams p;
+    p.base_color = texture_param(node, "base_color", Color(0.5f));
+    p.roughness = texture_param(node, "roughness", Color(0.5f));
+    p.anisotropic = principled_lobe_param(node, "anisotropic");
+    p.metallic = principled_lobe_param(node, "metallic");
+    p.spec_trans = principled_lobe_param(node, "spec_trans");
+    p.spec_tint = principled_lobe_param(node, "spec_tint");
+    p.sheen = principled_lobe_param(node, "sheen");
+    p.sheen_tint = principled_lobe_param(node, "sheen_tint");
+    p.flatness = principled_lobe_param(node, "flatness");
+    p.clearcoat = principled_lobe_param(node, "clearcoat");
+    // Read whether or not there is a clearcoat, as Mitsuba does (it is then merely unused).
+    p.clearcoat_gloss = texture_param(node, "clearcoat_gloss", Color(0.f));
+    if (node.has("eta") && node.has("specular")) throw node.error("give either 'eta' or 'specular', not both");
+    if (node.has("eta")) {
+        p.eta = node.get_float("eta");
+        if (!(p.eta > 0.f)) throw node.error("'eta' must be positive");
+        // A transmissive interface of IOR 1 is degenerate: Mitsuba moves it off 1.
+        if (p.spec_trans && p.eta == 1.f) p.eta = 1.001f;
+    } else {
+        float specular = node.get_float("specular", 0.5f);
+        if (!(specular >= 0.f && specular < 12.5f)) throw node.error("'specular' must be in [0, 12.5)");
+        if (p.spec_trans && specular == 0.f) specular = 1e-3f;
+        p.eta = principled_eta_from_specular(specular);
+    }
+    p.main_specular_sampling_rate = node.get_float("main_specular_sampling_rate", 1.f);
+    p.clearcoat_sampling_rate = node.get_float("clearcoat_sampling_rate", 1.f);
+    p.diffuse_reflectance_sampling_rate = node.get_float("diffuse_reflectance_sampling_rate", 1.f);
+    for (float rate : {p.main_specular_sampling_rate, p.clearcoat_sampling_rate, p.diffuse_reflectance_sampling_rate})
+        if (!(rate >= 0.f)) throw node.error("sampling rates must be non-negative");
+    if (!(p.main_specular_sampling_rate > 0.f))
+        throw node.error("'main_specular_sampling_rate' must be positive (the specular lobes would never be sampled)");
+    return p;
+}
+
+PrincipledThinParams Factories::principled_thin_params(const XmlNode &node) {
+    PrincipledThinParams p;
+    p.base_color = texture_param(node, "base_color", Color(0.5f));
+    p.roughness = texture_param(node, "roughness", Color(0.5f));
+    p.eta = texture_param(node, "eta", Color(1.5f));
+    p.anisotropic = principled_lobe_param(node, "anisotropic");
+    p.spec_trans = principled_lobe_param(node, "spec_trans");
+    p.spec_tint = principled_lobe_param(node, "spec_tint");
+    p.sheen = principled_lobe_param(node, "sheen");
+    p.sheen_tint = principled_lobe_param(node, "sheen_tint");
+    p.flatness = principled_lobe_param(node, "flatness");
+    p.diff_trans = principled_lobe_param(node, "diff_trans");
+    p.specular_reflectance_sampling_rate = node.get_float("specular_reflectance_sampling_rate", 1.f);
+    p.specular_transmittance_sampling_rate = node.get_float("specular_transmittance_sampling_rate", 1.f);
+    p.diffuse_reflectance_sampling_rate = node.get_float("diffuse_reflectance_sampling_rate", 1.f);
+    p.diffuse_transmittance_sampling_rate = node.get_float("diffuse_transmittance_sampling_rate", 1.f);
+    for (float rate : {p.specular_reflectance_sampling_rate, p.specular_transmittance_sampling_rate,
+                       p.diffuse_reflectance_sampling_rate, p.diffuse_transmittance_sampling_rate})
+        if (!(rate >= 0.f)) throw node.error("sampling rates must be non-negative");
+    if (!(p.diffuse_reflectance_sampling_rate > 0.f))
+        throw node.error("'diffuse_reflectance_sampling_rate' must be positive (the diffuse lobe would never be sampled)");
+    return p;
+}
+
 float ior_param(const XmlNode &node, const std::string &name, float def) {
     if (!node.has(name)) return def;
     const XmlProperty &p = node.props.at(name);
@@ -52,6 +123,11 @@ float ior_param(const XmlNode &node, const std::string &name, float def) {
 BSDFPtr Factories::default_bsdf() {
     if (!default_bsdf_) default_bsdf_ = std::make_shared<DiffuseBSDF>(constant_texture(0.5f));
     return default_bsdf_;
+}
+
+BSDFPtr Factories::black_bsdf() {
+    if (!black_bsdf_) black_bsdf_ = std::make_shared<DiffuseBSDF>(constant_texture(0.f));
+    return black_bsdf_;
 }
 
 BSDFPtr Factories::bsdf(const XmlNode &node) {
@@ -128,6 +204,10 @@ BSDFPtr Factories::create_bsdf(const XmlNode &node) {
         TexturePtr tr = texture_param_or_null(node, "specular_transmittance");
         if (t == "dielectric") b = std::make_shared<DielectricBSDF>(int_ior, ext_ior, r, tr);
         else b = std::make_shared<ThinDielectricBSDF>(int_ior, ext_ior, r, tr);
+    } else if (t == "principled") {
+        b = std::make_shared<PrincipledBSDF>(principled_params(node));
+    } else if (t == "principledthin") {
+        b = std::make_shared<PrincipledThinBSDF>(principled_thin_params(node));
     } else {
         throw node.error("unsupported BSDF type '" + t + "' (supported: " + supported_list("bsdf") + ")");
     }

@@ -5,6 +5,8 @@
 #include <memory>
 #include "neepp/io/xml_tree.h"
 #include "neepp/materials/bsdf.h"
+#include "neepp/materials/principled.h"
+#include "neepp/materials/principledthin.h"
 #include "neepp/scene/scene.h"
 
 namespace neepp::loader {
@@ -17,15 +19,19 @@ public:
     TexturePtr texture_param_or_null(const XmlNode &node, const std::string &name);
     BSDFPtr bsdf(const XmlNode &node);
     BSDFPtr default_bsdf();
+    BSDFPtr black_bsdf();  // an emitter's default
     // Creates the shape (and its area light, if any) and adds both to the scene.
     void shape(const XmlNode &node, Scene &scene);
     void emitter(const XmlNode &node, Scene &scene);
 
 private:
     BSDFPtr create_bsdf(const XmlNode &node);
+    TexturePtr principled_lobe_param(const XmlNode &node, const std::string &name);
+    PrincipledParams principled_params(const XmlNode &node);
+    PrincipledThinParams principled_thin_params(const XmlNode &node);
     std::map<const XmlNode *, TexturePtr> textures_;
     std::map<const XmlNode *, BSDFPtr> bsdfs_;
-    BSDFPtr default_bsdf_;
+    BSDFPtr default_bsdf_, black_bsdf_;
 };
 
 // The scene's <integrator>: its type and options, with Mitsuba 3's integrators mapped to the one here

@@ -24,28 +24,30 @@ MeshData rectangle_mesh() {
     return m;
 }
 
-// Mitsuba's `cube`: [-1,1]^3, four vertices per face so each face has its own outward normal.
+// Mitsuba's `cube`: [-1,1]^3, four vertices per face so each face has its own outward normal, with
+// Mitsuba's face order and texture coordinates: a face is the point n + (2u - 1) U + (2v - 1) V of its
+// uv square, its corners in the order uv (0,1), (1,1), (1,0), (0,0), triangles (0,1,2) and (3,0,2). The
+// uv axes decide dp/du, so textures and anisotropic lobes land on a cube as they do in Mitsuba.
 MeshData cube_mesh() {
+    struct Face {
+        Vec3 n, u, v;  // cross(u, v) = -n: the triangles wind counter-clockwise seen from outside
+    };
+    const Face faces[6] = {
+        {{0, -1, 0}, {0, 0, 1}, {1, 0, 0}},  {{0, 1, 0}, {-1, 0, 0}, {0, 0, -1}},
+        {{1, 0, 0}, {0, 1, 0}, {0, 0, -1}},  {{0, 0, 1}, {0, 1, 0}, {1, 0, 0}},
+        {{-1, 0, 0}, {0, 1, 0}, {0, 0, 1}},  {{0, 0, -1}, {0, -1, 0}, {1, 0, 0}},
+    };
+    const Vec2 corners[4] = {{0, 1}, {1, 1}, {1, 0}, {0, 0}};
     MeshData m;
-    for (int axis = 0; axis < 3; ++axis)
-        for (int sign = -1; sign <= 1; sign += 2) {
-            Vec3 n(0.f);
-            n[axis] = float(sign);
-            int a = (axis + 1) % 3, b = (axis + 2) % 3;
-            uint32_t base = uint32_t(m.positions.size());
-            const float corners[4][2] = {{-1, -1}, {1, -1}, {1, 1}, {-1, 1}};
-            for (auto &c : corners) {
-                Vec3 p = n;
-                p[a] = c[0];
-                p[b] = c[1];
-                m.positions.push_back(p);
-                m.normals.push_back(n);
-                m.uvs.push_back({(c[0] + 1) * 0.5f, (c[1] + 1) * 0.5f});
-            }
-            // Counter-clockwise seen from outside: (a, b, n) is right-handed, so flip for negative faces.
-            if (sign > 0) m.indices.insert(m.indices.end(), {base, base + 1, base + 2, base + 2, base + 3, base});
-            else m.indices.insert(m.indices.end(), {base, base + 2, base + 1, base + 2, base, base + 3});
+    for (const Face &f : faces) {
+        const uint32_t base = uint32_t(m.positions.size());
+        for (const Vec2 &uv : corners) {
+            m.positions.push_back(f.n + f.u * (2 * uv.x - 1) + f.v * (2 * uv.y - 1));
+            m.normals.push_back(f.n);
+            m.uvs.push_back(uv);
         }
+        m.indices.insert(m.indices.end(), {base, base + 1, base + 2, base + 3, base, base + 2});
+    }
     return m;
 }
 
@@ -210,7 +212,6 @@ void Factories::shape(const XmlNode &node, Scene &scene) {
         throw node.error(e.what());
     }
 
-    s->bsdf = default_bsdf();
     const XmlNode *emitter_node = nullptr;
     for (const auto &child : node.children) {
         attempt([&] {  // when checking, a broken BSDF leaves the shape the default one
@@ -222,6 +223,8 @@ void Factories::shape(const XmlNode &node, Scene &scene) {
             else throw child->error("unsupported inside a shape: <" + child->tag + ">");
         });
     }
+    // Mitsuba's default: diffuse 0.5, black on an emitter (a light without a BSDF reflects nothing).
+    if (!s->bsdf) s->bsdf = emitter_node ? black_bsdf() : default_bsdf();
     warn_unused(node);
     Shape *shape = s.get();
     scene.add_shape(std::move(s));

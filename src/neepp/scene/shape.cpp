@@ -163,7 +163,14 @@ void Shape::fill_interaction(uint32_t prim, float b1, float b2, const Ray &ray, 
         si.uv = Vec2(phi * kInv2Pi, std::acos(std::clamp(local.z, -1.f, 1.f)) * kInvPi);
         si.dpdu = Vec3(-local.y, local.x, 0) * (2.f * kPi * radius);
         si.dpdv = cross(si.n, si.dpdu);
-        si.sh_frame = Frame(si.n);
+        // Aligned with dp/du where the BSDF reads tangents, as Mitsuba; at the poles dp/du vanishes.
+        const float du2 = squared_norm(si.dpdu);
+        if (tangents && du2 > 0.f) {
+            const Vec3 s = si.dpdu / std::sqrt(du2);
+            si.sh_frame = Frame(s, cross(si.n, s), si.n);
+        } else {
+            si.sh_frame = Frame(si.n);
+        }
         return;
     }
     const HitTriangle &tri = hit_triangles_[prim];
