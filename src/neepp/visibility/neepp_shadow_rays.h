@@ -165,7 +165,8 @@ private:
     double adaptive_scale_ = 0;
     Phase phase_ = Phase::Probe;
     Totals totals_;
-    // Native thread-local keys: local() is read on every shadow query, where the default hash lookup showed.
+    // Native thread-local keys: local() is read on every shadow query, where the default hash lookup is a
+    // visible cost.
     mutable tbb::enumerable_thread_specific<ThreadState, tbb::cache_aligned_allocator<ThreadState>, tbb::ets_key_per_instance>
         threads_;
 };
