@@ -22,8 +22,8 @@ constexpr int kMaxUnboundedVertices = 64;
 // candidate the map wrongly believes hidden keeps a probability of at least 0.1 / K.
 constexpr float kUniformMix = 0.1f;
 // Vertices of each side a candidate's score looks at: each pair is a visibility-map read (a cache miss,
-// the map being tens of MB), and deep vertices carry little throughput. All of them (up to 17 x 17 pairs
-// per candidate) doubled a sample's time on bathroom and veach-ajar for K = 4.
+// the map being tens of MB), and deep vertices carry little throughput. Scoring all of them (up to 17 x 17
+// pairs per candidate) would make each sample much slower.
 constexpr int kScoreVertices = 3;
 // Pool paths' sampler: its own seed, so that pool paths and camera samples never share numbers.
 constexpr uint64_t kPoolSeed = 0x706f6f6c6c696768ULL;
@@ -120,8 +120,8 @@ bool BDPTIntegrator::wants(int s, int t) const {
 float BDPTIntegrator::mis_weight(const std::vector<PathVertex> &light, const std::vector<PathVertex> &camera,
                                  const PathVertex &sampled, int s, int t) const {
     if (s + t == 2) return 1.f;
-    // Not zero-filled: only the first s and t entries are read (filling the arrays was a fifth of the
-    // function's time).
+    // Not zero-filled: only the first s and t entries are read (filling the arrays would be a good part of
+    // the function's time).
     const PathVertex *lv[kMaxUnboundedVertices + 2], *cv[kMaxUnboundedVertices + 2];
     cv[0] = &sampled;  // t >= 1 always; tells the compiler cv[t - 1] is written
     float lfwd[kMaxUnboundedVertices + 2], lrev[kMaxUnboundedVertices + 2];

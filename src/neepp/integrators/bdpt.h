@@ -17,8 +17,8 @@
 // its vertices' voxels and the candidate's (times both throughputs' luminance), chosen with probability
 // p_i ∝ score mixed with 10 % uniform, and weighted by 1 / (K p_i). The candidates are independent light
 // subpaths, so this estimates what the connection with one light subpath does and every strategy keeps
-// its MIS weight. K = 1 is plain BDPT. (A first version connected only pool paths, sharing 4096 per pass
-// among all camera samples and leaving t = 1 to them: 14-37x plain BDPT's relative variance.)
+// its MIS weight. K = 1 is plain BDPT. (Connecting only pool paths, shared among all camera samples, and
+// leaving t = 1 to them gives many times plain BDPT's variance.)
 #pragma once
 #include <memory>
 #include <string>

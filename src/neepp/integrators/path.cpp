@@ -230,8 +230,8 @@ bool PathIntegrator::finish_vertex(Path &path) const {
 void PathIntegrator::Li_batch(const Scene &scene, std::span<const Ray> rays, std::span<Sampler *const> samplers,
                               std::span<Color> out, RenderCounters &counters) const {
     constexpr size_t kBatch = 32;
-    // The paths' slots live as long as the thread: built once, not at every call (a call takes 32
-    // samples, and building 32 slots of ~0.5 KB each cost 1 % of the render's instructions). Path::start
+    // The paths' slots live as long as the thread: built once, not at every call (a call takes only 32
+    // samples, and building 32 slots of ~0.5 KB each every time is a cost for nothing). Path::start
     // resets what a new path reads before writing.
     struct Slots {
         std::array<Path, kBatch> paths;

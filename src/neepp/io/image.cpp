@@ -125,7 +125,7 @@ std::vector<std::string> pick_exr_channels(const Imf::ChannelList &list, const s
 Image read_exr(const std::string &path) {
     try {
         // OpenEXR decodes the file's blocks on its global thread pool (InputFile's default), which is empty
-        // until given threads (classroom's 8 MB environment map took a quarter of its load on one thread).
+        // until given threads (on one thread, a large environment map is a good part of a scene's load).
         [[maybe_unused]] static const bool pool = [] {
             Imf::setGlobalThreadCount(int(std::max(1u, std::thread::hardware_concurrency())));
             return true;

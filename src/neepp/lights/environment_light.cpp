@@ -18,9 +18,9 @@ EnvironmentMapLight::EnvironmentMapLight(Image image, const Transform &to_world,
     width_ = image.width, height_ = image.height;
     if (image.width < 2 || image.height < 2) throw std::runtime_error("envmap: image too small");
     const int w = width_, h = height_;
-    // Each pass over the texels runs over rows in parallel (a 2k map's passes were a fifth of classroom's
-    // loading on one thread); what is summed across rows is summed in row order, so the results do not
-    // depend on the thread count.
+    // Each pass over the texels runs over rows in parallel (on one thread a large map's passes are a
+    // good part of a scene's loading); what is summed across rows is summed in row order, so the results
+    // do not depend on the thread count.
     auto rows = [](int count, auto &&body) {
         tbb::parallel_for(tbb::blocked_range<int>(0, count), [&](const tbb::blocked_range<int> &r) {
             for (int y = r.begin(); y < r.end(); ++y) body(y);
@@ -86,10 +86,9 @@ EnvironmentMapLight::EnvironmentMapLight(Image image, const Transform &to_world,
         for (int y = 0; y < h; ++y)
             for (int x = 0; x < w; ++x) weights[size_t(y) * w + x] = row_sin_theta(y);
     // Sample on a grid of at most kMaxSampleWidth x kMaxSampleWidth/2 cells: a table of 4 MB, where one per
-    // texel of a 2k map (16 MB) made light samples cache misses. Classroom 320x180 (2k sky with a small
-    // sun), 64 spp, relative variance over 4 seeds: 512 cells 0.1603, 1024 0.1555 (-3 %, same speed),
-    // 2048 0.1548 (-3.4 %, but -5.5 % samples/s). Each coarse cell sums the texel cells it overlaps, so it
-    // is positive wherever radiance is; within a cell directions are uniform in uv.
+    // texel of a 2k map (16 MB) makes light samples cache misses. A finer grid lowers the variance little
+    // and slows sampling. Each coarse cell sums the texel cells it overlaps, so it is positive wherever
+    // radiance is; within a cell directions are uniform in uv.
     sample_w_ = std::min(w, kMaxSampleWidth);
     sample_h_ = std::min(h, kMaxSampleWidth / 2);
     std::vector<float> coarse(size_t(sample_w_) * sample_h_, 0.f);
@@ -195,8 +194,8 @@ LightSampleStart EnvironmentMapLight::begin_sample(Vec2 u) const {
     LightSampleStart start{u};
     start.point = sample_uv(u, start.density);
     // lookup(uv)'s bilinear footprint, which finish_sample reads: in each of its two texel rows, the first
-    // and the last byte loaded (two texels and a half, 14 bytes, cross a cache line one time in five; with
-    // the first line only, that line's misses were ~half of classroom's time in lookup).
+    // and the last byte loaded (two texels and a half, 14 bytes, cross a cache line one time in five, and
+    // with the first line only prefetched, misses on the second are a large part of lookup's time).
     const int x = std::min(int(start.point.x * float(width_)), width_ - 1);
     const int y = std::min(int(start.point.y * float(height_ - 1)), height_ - 1), y1 = std::min(y + 1, height_ - 1);
     for (int row : {y, y1}) {

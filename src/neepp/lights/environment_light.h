@@ -62,9 +62,9 @@ private:
     };
     Bilinear bilinear(Vec2 uv) const;
     // Texels as half floats (RGB, 6 bytes): a 2k map is 12.6 MB instead of 25 MB, so with the sampling
-    // table it stays in the last-level cache, where float texels made every sampled direction a miss to
-    // memory (8-11 % of classroom's render time). Half keeps 11 significant bits, below the noise of any
-    // render, and is what most EXR environment maps are stored in; maps beyond half's range stay float.
+    // table it stays in the last-level cache, where float texels make every sampled direction a miss to
+    // memory. Half keeps 11 significant bits, below the noise of any render, and is what most EXR
+    // environment maps are stored in; maps beyond half's range stay float.
     int width_ = 0, height_ = 0;
     std::vector<uint16_t> half_;
     std::vector<float> float_;

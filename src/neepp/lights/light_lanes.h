@@ -3,9 +3,8 @@
 // the only light of bathroom, cornell-box, staircase and veach-ajar), for a batch's paths together.
 //
 // Why: one such sample is a few dozen operations, but a square root, then a division that needs it, then
-// another that needs both, each waiting on the last (long latency); scalar, it cost ~660 instructions per
-// sample on bathroom (callgrind, 64², ~4 samples each, AreaLight::sample_direction and
-// Shape::sample_position), and more time than that count suggests. In lanes, eight share each wait.
+// another that needs both, each waiting on the last (long latency); scalar, it takes more time than its
+// count of instructions suggests. In lanes, eight share each wait.
 #pragma once
 #include <cstddef>
 

@@ -40,9 +40,9 @@ CoatingTables compute_coating_tables(MicrofacetType type, float alpha, float eta
     return t;
 }
 
-// The tables depend only on (distribution, alpha, eta), which a scene's rough plastics often share
-// (staircase: 6 materials, 2 distinct; bathroom 5, 3), and each costs as much as loading a large mesh:
-// computed once per process and copied into each BSDF, whose lookups then stay local.
+// The tables depend only on (distribution, alpha, eta), which a scene's rough plastics often share, and
+// each costs as much as loading a large mesh: computed once per process and copied into each BSDF, whose
+// lookups then stay local.
 const CoatingTables &coating_tables(MicrofacetType type, float alpha, float eta) {
     static std::mutex mutex;
     static std::map<std::tuple<int, float, float>, std::unique_ptr<const CoatingTables>> memo;

@@ -94,8 +94,7 @@ void ImageBlock::clear() { std::fill(sums_.begin(), sums_.end(), 0.0); }
 
 namespace {
 // A pixel's four sums (r, g, b, weight) as one 256-bit vector: a sample adds w·(L, 1) to each pixel of its
-// footprint in one multiply-add, rather than four scalar ones (the film, with the scenes' tent filter, was
-// 8 % of our instructions per sample on cornell-box; now 5.6 %). Unaligned, and may alias the doubles it is
+// footprint in one multiply-add, rather than four scalar ones. Unaligned, and may alias the doubles it is
 // read from.
 typedef double Sums4 __attribute__((vector_size(32), aligned(8), may_alias));
 }  // namespace

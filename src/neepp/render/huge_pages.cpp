@@ -12,7 +12,7 @@ constexpr const char *kTunable = "glibc.malloc.hugetlb";
 // With huge pages, every block glibc maps on its own (those over the mmap threshold, 128 KB to 32 MB,
 // adjusted as it goes) is a fresh mapping whose 2 MB pages the kernel zeroes whole on first touch, and
 // loading a scene allocates and frees many such blocks (a mesh's arrays, growing as it is parsed; decoded
-// images): bathroom spent a quarter of a second of its load zeroing pages. Blocks under 32 MB therefore
+// images), so a load would spend a noticeable part of its time zeroing pages. Blocks under 32 MB therefore
 // come from the heap, and freed memory stays there (up to 256 MB at its top) for the next ones.
 constexpr std::pair<const char *, const char *> kWith[] = {{"glibc.malloc.mmap_threshold", "33554432"},
                                                            {"glibc.malloc.trim_threshold", "268435456"}};

@@ -1,10 +1,9 @@
 // Transparent huge pages for the render's large arrays. A render reads meshes, textures, Embree's BVH and
-// NEE++'s visibility map at random, and with 4 KB pages most of those reads also miss the TLB (perf puts a
-// texture prefetch's page walk among the costliest instructions on bathroom). glibc's allocator can
+// NEE++'s visibility map at random, and with 4 KB pages most of those reads also miss the TLB (a texture
+// prefetch's page walk is among the costliest instructions of a render). glibc's allocator can
 // advise the kernel to back its large blocks with 2 MB pages (the glibc.malloc.hugetlb=1 tunable; the
 // kernel's THP mode "madvise", Debian's default, honours it), but it reads its tunables only when a
 // process starts: the command-line tool therefore restarts itself once with the tunable added.
-// Bathroom 512², 2 threads: +3.7 % samples/s (median of 5 interleaved runs); classroom unchanged.
 #pragma once
 #include <string>
 

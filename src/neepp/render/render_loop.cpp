@@ -40,8 +40,7 @@ std::vector<Tile> make_tiles(int width, int height, int size) {
 // gets small passes, so that it learns early, growing geometrically (capped) so per-pass overhead stays
 // negligible. One that does not gets full passes at once: a pixel's samples in a pass are consecutive, so
 // each packet of 16 rays the path tracer traces then starts from one pixel, and coherent rays are cheaper
-// to trace (bathroom 128², 64 spp: passes of 32 give +8.5 % samples/s over passes of 1, +1.7 % over
-// passes of 16). Under a time limit a pass is sized to end before the deadline by the speed of the last
+// to trace. Under a time limit a pass is sized to end before the deadline by the speed of the last
 // (with a 5% margin): a pass is all or nothing, so one cut off by the deadline would be work thrown away.
 int next_pass_size(int done, int target, double seconds_per_spp, double remaining_s, bool timed, bool learns) {
     constexpr int kMaxPass = 32;

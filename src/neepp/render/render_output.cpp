@@ -12,8 +12,8 @@ namespace neepp {
 
 // The peak resident set of this program image (VmHWM), not getrusage's ru_maxrss: Linux folds into
 // ru_maxrss the peak of the address space that exec replaced, and a child that Python's subprocess
-// starts (vfork, then exec) replaces its parent's, so ru_maxrss reported the benchmark script's own
-// peak (classroom: 136 to 220 MB, as the script grew, for a render that peaks at 93 MB).
+// starts (vfork, then exec) replaces its parent's, so ru_maxrss can report the benchmark script's own
+// peak, far above the render's.
 double peak_memory_mb() {
     if (std::ifstream status("/proc/self/status"); status) {
         std::string line;

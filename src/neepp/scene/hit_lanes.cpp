@@ -1,12 +1,10 @@
 // Triangle hits filled eight at a time (Shape::HitLanes): the first step of shading in SoA.
 //
 // Why: filling a hit record (interpolated position, face and vertex normals, uv, shading frame, wi) is
-// scalar arithmetic with two square roots and three divisions per hit, and it cost ~1,000 instructions
-// per sample on bathroom (callgrind, 64², 4.9 hits per sample: fill_interaction 790, wi and the call
-// ~220), an eighth of neepp's own. With one AVX lane per hit, the kernel below takes ~300 and queueing the
-// hits into lanes ~250. What stays costly is moving data between the paths' records (AoS) and the lanes
-// (SoA); 8x8 transposes do it: a triangle's record is three rows of 8 floats, and so are the first 24
-// floats of a hit record.
+// scalar arithmetic with two square roots and three divisions per hit, a large share of neepp's own
+// work per sample. The kernel below gives each hit one AVX lane. What stays costly is moving data
+// between the paths' records (AoS) and the lanes (SoA); 8x8 transposes do it: a triangle's record is
+// three rows of 8 floats, and so are the first 24 floats of a hit record.
 #include <cstddef>
 
 #include "neepp/scene/shape.h"

@@ -12,8 +12,8 @@ struct Shape;
 
 // Mitsuba 3's offsets (math::RayEpsilon and ShadowEpsilon), larger than float precision alone needs:
 // scenes made for Mitsuba are modelled around them. Bathroom's light bulbs are two glass shells 6e-5
-// apart; with an offset of 1e-5 (1 + |p|), a ray leaving one shell met the other, which Mitsuba's rays
-// step over, and the bulbs reflected in the mirror came out 14 % brighter than Mitsuba renders them.
+// apart; with a smaller offset, a ray leaving one shell meets the other, which Mitsuba's rays step
+// over, and the bulbs reflected in the mirror come out brighter than Mitsuba renders them.
 inline constexpr float kRayEpsilon = 1500.f * 0x1p-24f;
 inline constexpr float kShadowEpsilon = 10.f * kRayEpsilon;
 

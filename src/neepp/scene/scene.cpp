@@ -138,8 +138,7 @@ Scene::Scene() {
     if (!device_) throw std::runtime_error("could not create an Embree device");
     rtcSetDeviceErrorFunction(device_, embree_error, nullptr);
     // The widest packet this CPU's Embree kernels trace natively. A wider one is split by Embree's
-    // stream path: on AVX2 (8 lanes), packets of 16 rendered classroom and bathroom 13-15 % slower than
-    // packets of 8 (medians of 6 interleaved runs each); on AVX-512, 16 was the fastest.
+    // stream path, which traces slower than packets of the native width.
     packet_width_ = rtcGetDeviceProperty(device_, RTC_DEVICE_PROPERTY_NATIVE_RAY16_SUPPORTED) ? 16
                     : rtcGetDeviceProperty(device_, RTC_DEVICE_PROPERTY_NATIVE_RAY8_SUPPORTED) ? 8
                                                                                                : 4;

@@ -50,8 +50,7 @@ public:
     RayHit trace(const Ray &ray) const;
     // trace() of up to 16 rays at once, as Embree packets of packet_width(); coherent: the rays start
     // close together in similar directions (camera rays of a few neighbouring pixels), so Embree may use
-    // its coherent traversal (bathroom, callgrind: -0.8 % instructions; for shadow rays toward lights it
-    // cost +1.7 %).
+    // its coherent traversal (it saves work for camera rays; for shadow rays toward lights it costs more).
     void trace16(const Ray *const *rays, RayHit *const *hits, int n, bool coherent = false) const;
     // Prefetches what fill() will read for hit (its triangle's record). A hint: no effect on results.
     void prefetch(const RayHit &hit) const {
@@ -70,7 +69,7 @@ public:
     }
     bool occluded(const Ray &ray) const;
     // Up to 16 rays, as packets; coherent as for trace16. The path tracer does not set it: even the shadow
-    // rays of the first hits, which leave one pixel, traced 1.2-1.8x slower with it (bench/ray_replay).
+    // rays of the first hits, which leave one pixel, trace slower with it (bench/ray_replay).
     void occluded16(const Ray *const *rays, int n, bool *occluded, bool coherent = false) const;
     // The lanes of the packets trace16 and occluded16 give Embree: the widest this CPU traces natively
     // (16 with AVX-512, 8 with AVX2, else 4). Settable (4, 8, 16) for tests and measurements.

@@ -135,9 +135,9 @@ PositionSample Shape::sample_position(Vec2 u, bool with_uv) const {
     return ps;
 }
 
-// Always inlined into fill_interaction (both of its paths; GCC kept it out of line: 1 % of bathroom's
-// instructions). Inlined, its arithmetic may fuse differently with the caller's (FMA), which moves a few
-// paths onto other random decisions: the same image statistically, not to the bit.
+// Always inlined into fill_interaction (both of its paths; GCC otherwise keeps it out of line, and the
+// call is costly on a path this hot). Inlined, its arithmetic may fuse differently with the caller's
+// (FMA), which moves a few paths onto other random decisions: the same image statistically, not to the bit.
 [[gnu::always_inline]] inline Vec3 Shape::shading_normal(const HitTriangle &tri, float b0, float b1, float b2, const Vec3 &ng) const {
     if (face_normals || normals.empty()) return ng;
     Vec3 ns = tri.n[0] * b0 + tri.n[1] * b1 + tri.n[2] * b2;

@@ -90,9 +90,9 @@ struct Shape {
         if (h.n == kHitLanes) fill_lanes(h);
     }
     // Fills the queued hits and empties the lanes. The kernel costs as much for one lane as for eight, but
-    // filling the last few of a batch one at a time saved nothing (bathroom: 0.01 %), and each lane's
-    // result depends on nothing else: a path gets the same hit records, so the same image to the bit,
-    // whether it is traced alone or with others.
+    // filling the last few of a batch one at a time saves nothing, and each lane's result depends on
+    // nothing else: a path gets the same hit records, so the same image to the bit, whether it is traced
+    // alone or with others.
     static void fill_lanes(HitLanes &h);
 
     // A mesh of two triangles forming a parallelogram (Mitsuba's `rectangle`, a quad from a file) is

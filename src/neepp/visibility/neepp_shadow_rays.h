@@ -62,28 +62,27 @@ struct NeeppOptions {
     // path, q approaches 1 and the policy falls back to plain NEE instead of losing to it.
     // "rays": c such that as many rays are traced as the paper's rule would (equal ray budget).
     std::string adaptive_target = "efficiency";
-    // c_r / T: the time of one shadow ray as a fraction of a whole sample's. Measured on the Bitterli
-    // scenes with `nee` (occlusion_time_s / shadow rays against render time per sample): 0.04-0.05.
+    // c_r / T: the time of one shadow ray as a fraction of a whole sample's. The default is what `nee`
+    // takes on the Bitterli scenes (occlusion_time_s / shadow rays against render time per sample).
     // A fixed option, not a live timing, so renders stay reproducible.
     float shadow_ray_cost = 0.05f;
     std::string map_file;        // load if present and matching, else build and save here; "" = no file
     bool learn = true;           // update the map online from the shadow rays the render traces
     // ... until a pair's count reaches this: its Ṽ is then known to ±3 % (binomial standard error at most
     // 0.5/sqrt(n)), enough for choosing q, and each further update would be a hash-table write per shadow
-    // ray (3 % of cornell-box's render time) that changes little. A map seeded wrong (16 samples) still
-    // learns 240 outcomes per pair before it stops. Read from the frozen map, so renders stay
-    // reproducible; applies where the policy reads the pair's counts anyway (roulette policies).
+    // ray that changes little. A map seeded wrong (16 samples) still learns 240 outcomes per pair before
+    // it stops. Read from the frozen map, so renders stay reproducible; applies where the policy reads the
+    // pair's counts anyway (roulette policies).
     int learn_until = 256;
     // Rejection stays on only if at least this fraction of the first pass's shadow rays were occluded
-    // (0 = always on). Measured with nee at 128², 8 spp: cornell-box 13 %, staircase 47 %, classroom 83 %,
-    // bathroom 86 %, veach-ajar 91 %, living-room 97 %. Only occluded rays are worth skipping, and they are
-    // the cheap ones (an occlusion query stops at the first hit, a visible ray crosses the whole scene):
-    // on staircase, skipping 47 % of the shadow rays left Embree's time unchanged while the lookups and
-    // the roulette's variance cost every policy 16-29 % at equal time; on cornell-box 6 % in time alone.
+    // (0 = always on). Only occluded rays are worth skipping, and they are the cheap ones (an occlusion
+    // query stops at the first hit, a visible ray crosses the whole scene): where fewer than half are
+    // occluded, skipping them leaves Embree's time nearly unchanged while the lookups and the roulette's
+    // variance cost every policy more than that saves.
     float min_occluded = 0.5f;
     // Build the map only after the first pass, and only if rejection stays on: a scene where rejection
-    // does not pay then costs no seeding (cornell-box: 0.03 s, 5 % of a 64 spp render at 128²). The
-    // factory turns this off when a light sampler reads the map from the first pass.
+    // does not pay then costs no seeding. The factory turns this off when a light sampler reads the map
+    // from the first pass.
     bool defer_seeding = false;
 };
 
@@ -166,7 +165,8 @@ private:
     double adaptive_scale_ = 0;
     Phase phase_ = Phase::Probe;
     Totals totals_;
-    // Native thread-local keys: local() is read on every shadow query, where the default hash lookup showed.
+    // Native thread-local keys: local() is read on every shadow query, where the default hash lookup is a
+    // visible cost.
     mutable tbb::enumerable_thread_specific<ThreadState, tbb::cache_aligned_allocator<ThreadState>, tbb::ets_key_per_instance>
         threads_;
 };
