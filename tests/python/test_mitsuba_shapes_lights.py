@@ -1,5 +1,5 @@
-"""Mitsuba 3's `disk` and `cylinder` shapes and `spot` and `directional` lights: two small scenes of the
-project's own (a spot light across a floor, a tilted cylinder between p0 and p1, a disk-shaped area light
+"""Mitsuba 3's `disk` and `cylinder` shapes, `spot` and `directional` lights and `null` BSDF: small scenes
+of the project's own (a spot light across a floor, a tilted cylinder between p0 and p1, a disk-shaped area light
 and a tilted diffuse disk; a sun-like directional light on a floor, a glossy sphere and a box) rendered by
 neepp's path tracer, BDPT and light tracer agree with Mitsuba 3's images: the mean within 1 % plus 4
 standard errors, and each of 3 x 3 regions within 2 % plus 4 standard errors (so a disk facing the wrong
@@ -45,8 +45,26 @@ DIRECTIONAL = """<scene version="3.0.0">
 </scene>
 """
 
+# A `null` sphere between the camera and the scene (no effect on light, but its crossings are bounces, as
+# in Mitsuba), and an area light whose shape has a `null` BSDF.
+NULL_BSDF = """<scene version="3.0.0">
+  <default name="spp" value="16"/>
+  <integrator type="path"><integer name="max_depth" value="6"/></integrator>
+  @SENSOR@
+  <shape type="rectangle"><transform name="to_world"><scale value="3"/><rotate x="1" angle="-90"/></transform>
+    <bsdf type="diffuse"><rgb name="reflectance" value="0.5"/></bsdf></shape>
+  <shape type="cube"><transform name="to_world"><scale value="0.3"/><translate x="-0.5" y="0.3"/></transform>
+    <bsdf type="diffuse"><rgb name="reflectance" value="0.2,0.6,0.3"/></bsdf></shape>
+  <shape type="sphere"><point name="center" x="0.2" y="0.6" z="1"/><float name="radius" value="0.6"/>
+    <bsdf type="null"/></shape>
+  <shape type="rectangle"><transform name="to_world"><scale value="0.4"/><rotate x="1" angle="90"/><translate y="2"/></transform>
+    <bsdf type="null"/><emitter type="area"><rgb name="radiance" value="8"/></emitter></shape>
+</scene>
+"""
+
 SCENES = {name: xml.replace("@SENSOR@", sensor(60, "0,1.2,3.2", "0,0.6,0"))
-          for name, xml in {"shapes_and_spot": SHAPES_AND_SPOT, "directional": DIRECTIONAL}.items()}
+          for name, xml in {"shapes_and_spot": SHAPES_AND_SPOT, "directional": DIRECTIONAL,
+                            "null_bsdf": NULL_BSDF}.items()}
 
 
 @pytest.fixture(scope="module", params=list(SCENES))

@@ -161,6 +161,8 @@ BSDFPtr Factories::create_bsdf(const XmlNode &node) {
     } else if (t == "twosided") {
         auto kids = nested(1, 2);
         b = std::make_shared<TwoSidedBSDF>(bsdf(*kids[0]), kids.size() > 1 ? bsdf(*kids[1]) : nullptr);
+    } else if (t == "null") {
+        b = std::make_shared<NullBSDF>();
     } else if (t == "mask") {
         auto kids = nested(1, 1);
         b = std::make_shared<MaskBSDF>(texture_param(node, "opacity", Color(0.5f)), bsdf(*kids[0]));

@@ -23,6 +23,23 @@ private:
 
 // Mitsuba's `mask`: an opacity texture; with probability 1 - opacity light passes straight through
 // (a null, delta-transmission event), otherwise the nested BSDF scatters it.
+// Mitsuba's `null`: the surface does not interact with light (a shape that only bounds something, an
+// emitter that does not reflect): every ray passes straight through, as a mask of opacity 0 would let it.
+class NullBSDF final : public BSDF {
+public:
+    Color eval(const BSDFContext &, const SurfaceInteraction &, const Vec3 &, const Vec3 &) const override { return Color(0.f); }
+    float pdf(const BSDFContext &, const SurfaceInteraction &, const Vec3 &, const Vec3 &) const override { return 0.f; }
+    BSDFSample sample(const BSDFContext &, const SurfaceInteraction &, const Vec3 &wi, float, Vec2) const override {
+        BSDFSample bs;
+        bs.wo = -wi;
+        bs.pdf = 1.f;
+        bs.sampled_flags = BSDFNull;
+        bs.weight = Color(1.f);
+        return bs;
+    }
+    uint32_t flags() const override { return BSDFNull; }
+};
+
 class MaskBSDF final : public BSDF {
 public:
     MaskBSDF(TexturePtr opacity, BSDFPtr nested) : opacity_(std::move(opacity)), nested_(std::move(nested)) {}
