@@ -2,6 +2,8 @@
 // (mitsuba_reference.inc) for the same parameters, directions and random numbers.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cstdio>
 #include <functional>
 #include <map>
 #include <string>
@@ -14,6 +16,7 @@
 #include "neepp/materials/principled.h"
 #include "neepp/materials/principledthin.h"
 #include "neepp/materials/roughconductor.h"
+#include "neepp/materials/roughdielectric.h"
 #include "neepp/materials/roughplastic.h"
 #include "neepp/materials/thindielectric.h"
 
@@ -43,6 +46,7 @@ struct Query {
 const Query kQueries[] = {
 #include "mitsuba_reference.inc"
 #include "principled_reference.inc"
+#include "roughdielectric_reference.inc"
 };
 
 TexturePtr tex(float v) { return constant_texture(v); }
@@ -73,6 +77,20 @@ std::map<std::string, BSDFPtr> make_bsdfs() {
     m["dielectric_default"] = std::make_shared<DielectricBSDF>(bk7, air);
     m["dielectric_water"] = std::make_shared<DielectricBSDF>(*lookup_dielectric_ior("water"), 1.2f);
     m["thindielectric_default"] = std::make_shared<ThinDielectricBSDF>(bk7, air);
+    // roughdielectric: the configurations of generate_roughdielectric_reference.py.
+    auto rough_dielectric = [](MicrofacetType type, float au, float av, float int_ior, float ext_ior,
+                               bool visible = true, TexturePtr r = nullptr, TexturePtr t = nullptr) {
+        return std::make_shared<RoughDielectricBSDF>(type, tex(au), tex(av), int_ior, ext_ior, r, t, visible);
+    };
+    m["roughdielectric_default"] = rough_dielectric(MicrofacetType::Beckmann, 0.1f, 0.1f, bk7, air);
+    m["roughdielectric_ggx_water"] =
+        rough_dielectric(MicrofacetType::GGX, 0.3f, 0.3f, *lookup_dielectric_ior("water"), air);
+    m["roughdielectric_ggx_aniso"] = rough_dielectric(MicrofacetType::GGX, 0.1f, 0.4f, 1.6f, air);
+    m["roughdielectric_beckmann_aniso_novis"] =
+        rough_dielectric(MicrofacetType::Beckmann, 0.35f, 0.15f, 1.7f, 1.2f, false);
+    m["roughdielectric_ggx_novis_tinted"] = rough_dielectric(MicrofacetType::GGX, 0.5f, 0.5f, bk7, air, false,
+                                                             tex(Color(0.9f, 0.7f, 0.5f)), tex(Color(0.3f, 0.6f, 0.8f)));
+    m["roughdielectric_beckmann_inverted"] = rough_dielectric(MicrofacetType::Beckmann, 0.25f, 0.25f, 1.f, 1.5f);
     // principled: the configurations of generate_principled_reference.py.
     auto principled = [](Color base, const std::function<void(PrincipledParams &)> &set) {
         PrincipledParams p;
@@ -166,6 +184,46 @@ TEST(MitsubaReference, EvalPdfAndSampleMatchMitsuba) {
     }
     EXPECT_GT(evals, 100);
     EXPECT_GT(samples, 100);
+}
+
+// roughdielectric's queries on their own, with the largest absolute and relative differences printed,
+// and the count of valid samples in each lobe so that a reference without both lobes shows.
+TEST(MitsubaReference, RoughDielectricAgreement) {
+    auto bsdfs = make_bsdfs();
+    SurfaceInteraction si;
+    double max_abs = 0, max_rel = 0;
+    int evals = 0, nonzero_evals = 0, reflected = 0, transmitted = 0;
+    auto diff = [&](float a, float b) {
+        max_abs = std::max(max_abs, double(std::abs(a - b)));
+        if (std::abs(b) > 1e-3f) max_rel = std::max(max_rel, double(std::abs(a - b) / std::abs(b)));
+    };
+    for (const Query &q : kQueries) {
+        if (!std::string(q.bsdf).starts_with("roughdielectric_")) continue;
+        const BSDF &bsdf = *bsdfs.at(q.bsdf);
+        BSDFContext ctx{q.mode};
+        si.wi = q.wi;
+        if (auto *e = std::get_if<std::pair<Vec3, Eval>>(&q.q)) {
+            const BSDFEval r = bsdf.eval_pdf(ctx, si, q.wi, e->first);
+            for (int i = 0; i < 3; ++i) diff(r.f[i], e->second.value[i]);
+            diff(r.pdf, e->second.pdf);
+            ++evals;
+            nonzero_evals += e->second.pdf > 0 && !is_black(e->second.value);
+        } else {
+            const Sample &s = std::get<Sample>(q.q);
+            if (!(s.pdf > 0 && !is_black(s.weight))) continue;
+            BSDFSample bs = bsdf.sample(ctx, si, q.wi, s.u1, s.u2);
+            for (int i = 0; i < 3; ++i) diff(bs.weight[i], s.weight[i]), diff(bs.wo[i], s.wo[i]);
+            diff(bs.pdf, s.pdf);
+            (s.wo.z * q.wi.z > 0 ? reflected : transmitted)++;
+        }
+    }
+    std::printf("roughdielectric vs Mitsuba: %d evals (%d non-zero), %d reflected and %d transmitted samples; "
+                "max abs diff %.3g, max rel diff %.3g\n",
+                evals, nonzero_evals, reflected, transmitted, max_abs, max_rel);
+    EXPECT_GT(nonzero_evals, 100);
+    EXPECT_GT(reflected, 30);
+    EXPECT_GT(transmitted, 100);
+    EXPECT_LT(max_rel, 2e-3);
 }
 
 }  // namespace

@@ -10,6 +10,7 @@
 #include "neepp/materials/principled.h"
 #include "neepp/materials/principledthin.h"
 #include "neepp/materials/roughconductor.h"
+#include "neepp/materials/roughdielectric.h"
 #include "neepp/materials/roughplastic.h"
 #include "neepp/materials/thindielectric.h"
 #include "neepp/materials/twosided.h"
@@ -206,6 +207,23 @@ BSDFPtr Factories::create_bsdf(const XmlNode &node) {
         TexturePtr tr = texture_param_or_null(node, "specular_transmittance");
         if (t == "dielectric") b = std::make_shared<DielectricBSDF>(int_ior, ext_ior, r, tr);
         else b = std::make_shared<ThinDielectricBSDF>(int_ior, ext_ior, r, tr);
+    } else if (t == "roughdielectric") {
+        TexturePtr au, av;
+        const bool has_u = node.has("alpha_u") || node.child("alpha_u"), has_v = node.has("alpha_v") || node.child("alpha_v");
+        if (has_u || has_v) {
+            if (!has_u || !has_v) throw node.error("give both 'alpha_u' and 'alpha_v'");
+            if (node.has("alpha") || node.child("alpha")) throw node.error("give either 'alpha' or 'alpha_u'/'alpha_v'");
+            au = texture_param(node, "alpha_u", Color(0.1f));
+            av = texture_param(node, "alpha_v", Color(0.1f));
+        } else {
+            au = av = texture_param(node, "alpha", Color(0.1f));
+        }
+        const float int_ior = ior_param(node, "int_ior", 1.5046f), ext_ior = ior_param(node, "ext_ior", 1.000277f);
+        if (int_ior == ext_ior) throw node.error("'int_ior' and 'ext_ior' must differ");
+        b = std::make_shared<RoughDielectricBSDF>(distribution_param(node), au, av, int_ior, ext_ior,
+                                                  texture_param_or_null(node, "specular_reflectance"),
+                                                  texture_param_or_null(node, "specular_transmittance"),
+                                                  node.get_bool("sample_visible", true));
     } else if (t == "principled") {
         b = std::make_shared<PrincipledBSDF>(principled_params(node));
     } else if (t == "principledthin") {

@@ -1,6 +1,7 @@
 // Microfacet normal distributions (Beckmann, GGX) with Smith shadowing and visible-normal sampling,
 // following Mitsuba 3's render/microfacet.h so rough BSDFs sample and evaluate exactly as Mitsuba's.
 #pragma once
+#include <cmath>
 #include <optional>
 #include <string_view>
 #include <utility>
@@ -48,6 +49,28 @@ private:
     float alpha_u_, alpha_v_;
     bool sample_visible_;
 };
+
+// The geometry of a rough dielectric interface (Walter et al. 2007), shared by Mitsuba's roughdielectric
+// and principled's transmission lobe. eta_path is the relative IOR seen from wi's side (eta from outside,
+// 1 / eta from inside); reflect says whether wo is on wi's side.
+// The generalized half vector of wi and wo, turned into the upper hemisphere.
+inline Vec3 dielectric_half_vector(const Vec3 &wi, const Vec3 &wo, bool reflect, float eta_path) {
+    const Vec3 m = normalize(wi + wo * (reflect ? 1.f : eta_path));
+    return m.z < 0.f ? -m : m;
+}
+// |d m / d wo|, the Jacobian that turns a density of microfacet normals into one of directions.
+inline float dielectric_half_vector_jacobian(float wi_m, float wo_m, bool reflect, float eta_path) {
+    return std::abs(reflect ? 1.f / (4.f * wo_m) : sqr(eta_path) * wo_m / sqr(wi_m + eta_path * wo_m));
+}
+// f |cos theta_o| of microfacet transmission, given the dielectric Fresnel reflectance, D and G at the half
+// vector m, wi.m, wo.m and cos theta_i. Radiance is compressed by 1 / eta_path^2 as it crosses the
+// interface; importance (radiance = false) is not.
+inline float dielectric_microfacet_transmission(float fresnel, float d, float g, float wi_m, float wo_m, float cos_i,
+                                                float eta_path, bool radiance) {
+    const float scale = radiance ? 1.f / sqr(eta_path) : 1.f;
+    return std::abs(scale * (1.f - fresnel) * d * g * sqr(eta_path) * wi_m * wo_m /
+                    (cos_i * sqr(wi_m + eta_path * wo_m)));
+}
 
 // Directional albedo of a rough dielectric interface seen from wi (Mitsuba's eval_reflectance /
 // eval_transmittance): single-scattering reflection resp. transmission, integrated with Gauss-Legendre

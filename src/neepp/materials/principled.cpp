@@ -164,13 +164,12 @@ BSDFEval PrincipledBSDF::eval_pdf(const BSDFContext &ctx, const SurfaceInteracti
     if ((!front || refract) && !(p_.spec_trans && bsdf > 0.f)) return {};
 
     const float eta_path = front ? p_.eta : 1.f / p_.eta;
-    Vec3 wh = normalize(wi + wo * (reflect ? 1.f : eta_path));
-    if (wh.z < 0.f) wh = -wh;
+    const Vec3 wh = dielectric_half_vector(wi, wo, reflect, eta_path);
     const float wi_h = dot(wi, wh), wo_h = dot(wo, wh);
     const float fresnel = fresnel_dielectric(wi_h, p_.eta).r;
     const LobeProbabilities prob = lobe_probabilities(l, front, fresnel);
     // |d wh / d wo|, the Jacobian of the half vector.
-    const float dwh_dwo = std::abs(reflect ? 1.f / (4.f * wo_h) : sqr(eta_path) * wo_h / sqr(wi_h + eta_path * wo_h));
+    const float dwh_dwo = dielectric_half_vector_jacobian(wi_h, wo_h, reflect, eta_path);
 
     BSDFEval r;
     if (microfacet_compatible(wh, wi, wo, reflect)) {
@@ -208,9 +207,8 @@ BSDFEval PrincipledBSDF::eval_pdf(const BSDFContext &ctx, const SurfaceInteracti
             if (fresnel < 1.f) {
                 // The rough dielectric's transmission; radiance is compressed by eta^2 when it enters a denser
                 // medium, importance is not.
-                const float scale = ctx.mode == TransportMode::Radiance ? 1.f / sqr(eta_path) : 1.f;
-                const float t = std::abs(scale * (1.f - fresnel) * d * g * sqr(eta_path) * wi_h * wo_h /
-                                         (cos_i * sqr(wi_h + eta_path * wo_h)));
+                const float t = dielectric_microfacet_transmission(fresnel, d, g, wi_h, wo_h, cos_i, eta_path,
+                                                                   ctx.mode == TransportMode::Radiance);
                 const Color &c = l.base_color;
                 r.f += Color(std::sqrt(c.x), std::sqrt(c.y), std::sqrt(c.z)) * (bsdf * t);
             }
