@@ -1,4 +1,5 @@
-"""Mitsuba 3's `disk` and `cylinder` shapes, `spot` and `directional` lights and `null` BSDF: small scenes
+"""Mitsuba 3's `disk` and `cylinder` shapes, `spot` and `directional` lights, `null` and `roughdielectric`
+BSDFs: small scenes
 of the project's own (a spot light across a floor, a tilted cylinder between p0 and p1, a disk-shaped area light
 and a tilted diffuse disk; a sun-like directional light on a floor, a glossy sphere and a box) rendered by
 neepp's path tracer, BDPT and light tracer agree with Mitsuba 3's images: the mean within 1 % plus 4
@@ -62,9 +63,32 @@ NULL_BSDF = """<scene version="3.0.0">
 </scene>
 """
 
+# Rough glass: a GGX sphere (visible normals) and an anisotropic Beckmann cube sampled without visible
+# normals, with tinted multipliers, on a floor under an area light and a constant sky (which keeps the
+# noise low enough that dropping the cube's tint fails the comparison): the caustics through them reach
+# the floor by refraction both ways, what the light tracer and BDPT's light subpaths carry as importance.
+ROUGH_DIELECTRIC = """<scene version="3.0.0">
+  <default name="spp" value="16"/>
+  <integrator type="path"><integer name="max_depth" value="8"/></integrator>
+  @SENSOR@
+  <shape type="rectangle"><transform name="to_world"><scale value="3"/><rotate x="1" angle="-90"/></transform>
+    <bsdf type="diffuse"><rgb name="reflectance" value="0.5"/></bsdf></shape>
+  <shape type="sphere"><point name="center" x="0.45" y="0.55" z="0"/><float name="radius" value="0.5"/>
+    <bsdf type="roughdielectric"><string name="distribution" value="ggx"/><float name="alpha" value="0.15"/>
+      <string name="int_ior" value="bk7"/></bsdf></shape>
+  <shape type="cube"><transform name="to_world"><scale value="0.45"/><rotate y="1" angle="30"/><translate x="-0.65" y="0.45" z="0.2"/></transform>
+    <bsdf type="roughdielectric"><string name="distribution" value="beckmann"/><float name="alpha_u" value="0.1"/>
+      <float name="alpha_v" value="0.35"/><float name="int_ior" value="1.33"/><boolean name="sample_visible" value="false"/>
+      <rgb name="specular_transmittance" value="0.2,0.5,0.9"/><rgb name="specular_reflectance" value="0.8"/></bsdf></shape>
+  <shape type="rectangle"><transform name="to_world"><scale value="0.8"/><rotate x="1" angle="90"/><translate x="0.2" y="2.2" z="-0.2"/></transform>
+    <emitter type="area"><rgb name="radiance" value="4"/></emitter></shape>
+  <emitter type="constant"><rgb name="radiance" value="0.3"/></emitter>
+</scene>
+"""
+
 SCENES = {name: xml.replace("@SENSOR@", sensor(60, "0,1.2,3.2", "0,0.6,0"))
           for name, xml in {"shapes_and_spot": SHAPES_AND_SPOT, "directional": DIRECTIONAL,
-                            "null_bsdf": NULL_BSDF}.items()}
+                            "null_bsdf": NULL_BSDF, "rough_dielectric": ROUGH_DIELECTRIC}.items()}
 
 
 @pytest.fixture(scope="module", params=list(SCENES))
