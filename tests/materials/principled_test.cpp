@@ -7,6 +7,7 @@
 #include <cstdio>
 #include <functional>
 
+#include "common/bsdf_test_helpers.h"
 #include "chi2.h"
 #include "neepp/materials/fresnel.h"
 #include "neepp/materials/principled.h"
@@ -110,22 +111,6 @@ BSDFPtr make_named(const std::string &name) {
     for (const ThinSet &s : thin_sets())
         if (s.name == name) return make_thin(s);
     return make(set_named(name));
-}
-
-Vec3 incident(float theta_deg) {
-    float t = theta_deg * kPi / 180.f;
-    return Vec3(std::sin(t) * std::cos(0.7f), std::sin(t) * std::sin(0.7f), std::cos(t));
-}
-
-Vec3 random_direction(PCG32 &rng, bool upper) {
-    Vec2 u = rng.next_2d();
-    float z = upper ? 0.02f + 0.98f * u.y : 1.f - 2.f * u.y, r = safe_sqrt(1 - z * z), phi = 2 * kPi * u.x;
-    return {r * std::cos(phi), r * std::sin(phi), z};
-}
-
-void expect_rel(const Color &a, const Color &b, float tol, const std::string &what) {
-    for (int i = 0; i < 3; ++i)
-        EXPECT_NEAR(a[i], b[i], tol * std::max(1e-4f, std::abs(b[i]))) << what << " [" << i << "]";
 }
 
 // ---- chi-square ----

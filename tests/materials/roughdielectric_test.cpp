@@ -8,6 +8,7 @@
 
 #include <functional>
 
+#include "common/bsdf_test_helpers.h"
 #include "chi2.h"
 #include "neepp/materials/fresnel.h"
 #include "neepp/materials/roughdielectric.h"
@@ -49,22 +50,6 @@ const Set &set_named(const std::string &name) {
     for (const Set &s : sets())
         if (s.name == name) return s;
     throw std::runtime_error("no set " + name);
-}
-
-Vec3 incident(float theta_deg) {
-    float t = theta_deg * kPi / 180.f;
-    return Vec3(std::sin(t) * std::cos(0.7f), std::sin(t) * std::sin(0.7f), std::cos(t));
-}
-
-Vec3 random_direction(PCG32 &rng, bool upper) {
-    Vec2 u = rng.next_2d();
-    float z = upper ? 0.02f + 0.98f * u.y : 1.f - 2.f * u.y, r = safe_sqrt(1 - z * z), phi = 2 * kPi * u.x;
-    return {r * std::cos(phi), r * std::sin(phi), z};
-}
-
-void expect_rel(const Color &a, const Color &b, float tol, const std::string &what) {
-    for (int i = 0; i < 3; ++i)
-        EXPECT_NEAR(a[i], b[i], tol * std::max(1e-4f, std::abs(b[i]))) << what << " [" << i << "]";
 }
 
 // ---- chi-square ----
