@@ -14,13 +14,16 @@ each renderer's render time (scene loading and acceleration-structure build excl
 the neepp/Tungsten ratio of each round's pair (median; metrics.paired_ratios; also the ratio of samples per
 CPU second of the render, which others' load on the machine disturbs less), and the image means (R, G, B,
 Rec. 709 luminance) of both renderers (all rounds averaged) and of the Mitsuba 3 reference in
-../shared/scenes/<scene>/reference/.
+../shared/scenes/<scene>/reference/. For context it also gives each renderer's relMSE against the reference
+(box-downsampled to the render's resolution; median over rounds) and the efficiency ratio
+(relMSE x time of Tungsten over neepp's: how much less time neepp needs for the same error at this spp).
 
 Path length. neepp takes Mitsuba 3's max_depth: the number of path segments (edges), max_depth=2 is direct
 lighting. Tungsten's max_bounces counts the same thing: its path tracer and BDPT trace camera/light
 subpaths of at most max_bounces+1 vertices (camera or light point included) and connect s+t <= max_bounces+1
 vertices, i.e. at most max_bounces segments; max_bounces=2 is direct lighting. So max_bounces = max_depth
-(--check-depth renders max_depth 1..3 with both to show it). Tungsten's own json2xml writes Mitsuba
+(--check-depth renders max_depth 1..4 with both to show it: the means agree to 0.1-0.2 %, and
+max_depth 1 is the light alone). Tungsten's own json2xml writes Mitsuba
 maxDepth = max_bounces + 1, which is one segment too many.
 
 Load. The machine may be shared. Around each render the script reads /proc/stat and the children's rusage:
@@ -37,18 +40,30 @@ scene.xml that neepp renders (meshes, textures, cameras, BSDFs and the area ligh
 as OBJ copies in the output folder). --convert converts every scene, which checks the converter against
 Bitterli's own JSON on cornell-box. Nothing of Tungsten or of the scenes is kept in this repository.
 
+Settings made equal: Tungsten's adaptive sampling is off (Bitterli's files turn it on) and its sampler is
+"stratified_sampler": false, i.e. independent numbers as the scenes' independent sampler; both PSSMLTs run over
+BDPT with large-step probability --mlt-large-step and --mlt-bootstrap bootstrap samples (neepp's defaults;
+Tungsten's are 0.1 and 10000). Not equal: Tungsten's kelemen_mlt runs one chain per thread, neepp 1024; each
+renderer keeps its own Russian roulette, MIS and small-step mutation.
+
 Building Tungsten (only for this measurement; never commit it or its scenes):
 
-    # fetch github:tunabrain/tungsten (tested at 88ea020) and github:gonsolo/bitterli, e.g. to /work/peers
-    git -C tungsten archive HEAD | tar -x -C /work/peers/tungsten    # or a plain clone
+    # the public repositories tunabrain/tungsten (tested at 88ea020; src/, cmake/ and data/ are needed: CMake
+    # copies data/) and gonsolo/bitterli, as plain clones, e.g. in /work/peers/tungsten and /work/peers/bitterli
     cd /work/peers/tungsten && mkdir build && cd build
     cmake -DCMAKE_BUILD_TYPE=Release -DTARGET_ARCHITECTURE=zen ..     # its CPU autodetection knows no
     make -j2 tungsten                                               # Zen 4/5 or "AMD EPYC": name one
-    # Tungsten's own defaults: SSE4.2 (AVX disabled by its CMakeLists), -O3; no OpenEXR 2 (HDR goes to .pfm)
+    # = Tungsten's own defaults: -O3, SSE4.2 (its CMakeLists disables AVX), Embree 2 with SSE4.2 kernels.
+    # It builds unchanged with GCC 12 (Debian 12). OpenEXR 3 is not found (it looks for OpenEXR 2's IlmImf),
+    # so its HDR output goes to .pfm, which this script reads. Qt5 is absent, so no editor is built.
+    # A build with the host's vector units, for comparison (-march=native alone enables AVX-512, which Embree
+    # 2's old AVX-512 code does not compile with):
+    #   cmake -DCMAKE_BUILD_TYPE=Release -DTARGET_ARCHITECTURE=none -DUSE_SSE4_2=ON -DEMBREE_MAX_ISA=AVX2 \
+    #         -DCMAKE_CXX_FLAGS="-march=native -mno-avx512f" -DCMAKE_C_FLAGS="-march=native -mno-avx512f" ..
 
     .venv/bin/python bench/tungsten_peer.py --tungsten /work/peers/tungsten/build/tungsten \\
-        --tungsten-scenes /work/peers/scenes
-    .venv/bin/python bench/tungsten_peer.py ... --scenes cornell-box --pairs bdpt --rounds 1 --spp 4 --quick
+        --tungsten-scenes /work/peers/bitterli --wait-quiet 900
+    .venv/bin/python bench/tungsten_peer.py ... --scenes cornell-box --pairs bdpt --rounds 1 --spp 4
     .venv/bin/python bench/tungsten_peer.py ... --check-depth                  # max_depth mapping check
 
 Writes bench/out/tungsten_peer/ (git-ignored): report.md, results.json, the generated Tungsten scenes, the
@@ -563,6 +578,10 @@ def measure(scene: str, pair: str, args, out: Path) -> dict:
         lums = [luminance(m) for m in per_round[k]]
         return statistics.stdev(lums) / math.sqrt(len(lums)) if len(lums) > 1 else float("nan")
 
+    f = ref.shape[1] // w
+    ref_small = metrics.downsample(ref, f) if f >= 1 and ref.shape[1] == w * f and ref.shape[0] == h * f else None
+    relmse = {k: (statistics.median(metrics.relmse(x[i], ref_small) for x in rounds) if ref_small is not None
+                  else float("nan")) for k, i in (("neepp", 1), ("tungsten", 2))}
     ratios = metrics.paired_ratios([x["ratio"] for x in recs])
     row = {"scene": scene, "pair": pair, "res": f"{w}x{h}", "max_depth": args.max_depth,
            "tungsten max_bounces": args.max_depth, "spp": spp, "rounds": len(recs),
@@ -577,12 +596,13 @@ def measure(scene: str, pair: str, args, out: Path) -> dict:
            "tungsten Y": luminance(mean_t), "tungsten Y stderr": lum_err("tungsten"), "ref Y": luminance(mean_r),
            "neepp/ref": luminance(mean_n) / luminance(mean_r), "tungsten/ref": luminance(mean_t) / luminance(mean_r),
            "neepp RGB": mean_n, "tungsten RGB": mean_t, "ref RGB": mean_r,
+           "neepp relMSE": relmse["neepp"], "tungsten relMSE": relmse["tungsten"],
+           "efficiency ratio": (relmse["tungsten"] * statistics.median(x["tungsten_render_time_s"] for x in recs)) /
+                               (relmse["neepp"] * statistics.median(x["neepp_render_time_s"] for x in recs)),
            "max other load (cores)": max(max(x["neepp_other_load_cores"], x["tungsten_other_load_cores"]) for x in recs),
            "tungsten scene": source, "ratios": ratios, "rounds_detail": recs, "attempts": attempts}
     exr.write_exr(work / "neepp_mean.exr", img_n)
     exr.write_exr(work / "tungsten_mean.exr", img_t)
-    f = ref.shape[1] // w
-    ref_small = metrics.downsample(ref, f) if f >= 1 and ref.shape[1] == w * f and ref.shape[0] == h * f else None
     report.comparison_figure(work / "compare.png", {"neepp": img_n, "tungsten": img_t}, ref=ref_small,
                              title=f"{scene} {pair}: {w}x{h}, {spp} spp x {len(recs)}, max_depth {args.max_depth}",
                              credit=credit(scene))
@@ -590,7 +610,7 @@ def measure(scene: str, pair: str, args, out: Path) -> dict:
 
 
 def check_depth(args, out: Path) -> list[dict]:
-    """Image means at max_depth 1..3 (neepp) against Tungsten max_bounces 1..3 (BDPT, cornell-box)."""
+    """Image means at max_depth 1..4 (neepp) against Tungsten max_bounces 1..4 (BDPT, the first scene)."""
     scene = args.scenes.split(",")[0]
     xml = Path(args.scenes_dir) / scene / "scene.xml"
     W, H = scene_film(xml)
@@ -660,7 +680,8 @@ def main(argv=None) -> int:
             (out / "results.json").write_text(json.dumps({"machine": machine.describe(), "rows": rows}, indent=2))
     cols = ["scene", "pair", "res", "max_depth", "spp", "neepp s", "tungsten s", "neepp samples/s",
             "tungsten samples/s", "ratio (median)", "ratio min", "ratio max", "cpu-time ratio (median)", "neepp Y", "tungsten Y", "ref Y",
-            "neepp/ref", "tungsten/ref", "max other load (cores)"]
+            "neepp/ref", "tungsten/ref", "neepp relMSE", "tungsten relMSE", "efficiency ratio",
+            "max other load (cores)"]
     md = [f"# neepp vs Tungsten ({a.threads} threads, box filter, max_depth {a.max_depth} = Tungsten max_bounces "
           f"{a.max_depth}, {a.rounds} rounds)\n\nmachine: {machine.summary()}\n\n"
           f"tungsten: {a.tungsten} {a.label}\n\n",
