@@ -1,3 +1,4 @@
+#include <gtest/gtest.h>
 #include "chi2.h"
 
 namespace neepp::test {
@@ -21,6 +22,21 @@ Chi2Result chi2_test(const BSDF &bsdf, const Vec3 &wi, const Chi2Config &cfg) {
     };
     auto pdf = [&](const Vec3 &wo) { return double(bsdf.pdf(ctx, si, wi, wo)); };
     return chi2_sphere_test(sample, pdf, sphere);
+}
+
+void expect_sampling_matches_pdf(const BSDF &bsdf, const Vec3 &wi, int ires, TransportMode mode, uint64_t seed,
+                                 size_t cases, const std::string &what) {
+    Chi2Config cfg;
+    cfg.sample_count = 400000;
+    cfg.ires = ires;
+    cfg.mode = mode;
+    cfg.seed = seed;
+    const Chi2Result r = chi2_test(bsdf, wi, cfg);
+    SCOPED_TRACE(what + ": " + r.describe());
+    ASSERT_TRUE(r.error.empty());
+    EXPECT_GT(r.p_value, 0.01 / double(cases));
+    EXPECT_LE(r.pdf_integral, 1.0 + 2e-3);
+    EXPECT_NEAR(r.pdf_integral, r.valid_fraction, 0.01);
 }
 
 }  // namespace neepp::test

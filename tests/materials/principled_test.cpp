@@ -148,18 +148,8 @@ class PrincipledChi2 : public ::testing::TestWithParam<size_t> {};
 
 TEST_P(PrincipledChi2, SamplingMatchesPdf) {
     const Chi2Case &k = chi2_cases()[GetParam()];
-    BSDFPtr bsdf = make_named(k.set);
-    Chi2Config cfg;
-    cfg.sample_count = 400000;
-    cfg.ires = k.ires;
-    cfg.mode = k.mode;
-    cfg.seed = 2000 + GetParam();
-    Chi2Result r = chi2_test(*bsdf, incident(k.theta_deg), cfg);
-    SCOPED_TRACE(k.set + " theta=" + std::to_string(k.theta_deg) + ": " + r.describe());
-    ASSERT_TRUE(r.error.empty());
-    EXPECT_GT(r.p_value, 0.01 / double(chi2_cases().size()));
-    EXPECT_LE(r.pdf_integral, 1.0 + 2e-3);
-    EXPECT_NEAR(r.pdf_integral, r.valid_fraction, 0.01);
+    expect_sampling_matches_pdf(*make_named(k.set), incident(k.theta_deg), k.ires, k.mode, 2000 + GetParam(),
+                                chi2_cases().size(), k.set + " theta=" + std::to_string(k.theta_deg));
 }
 
 INSTANTIATE_TEST_SUITE_P(Sets, PrincipledChi2, ::testing::Range<size_t>(0, chi2_cases().size()),
