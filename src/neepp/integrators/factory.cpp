@@ -1,3 +1,4 @@
+#include <algorithm>
 #include <sstream>
 #include <stdexcept>
 #include "neepp/integrators/bdpt.h"
@@ -93,9 +94,13 @@ std::unique_ptr<Integrator> make_integrator(const std::string &name, const Optio
         o.nee = options.get_bool("nee", o.nee);
         o.light_sampler = options.get_string("light_sampler", o.light_sampler);
         check_light_sampler_name(o.light_sampler);
+        o.within_light = options.get_string("within_light", o.within_light);
+        const auto &within = WithinLightSampling::names();
+        if (std::find(within.begin(), within.end(), o.within_light) == within.end())
+            throw std::invalid_argument("within_light must be 'own' or 'visibility', not '" + o.within_light + "'");
         if (o.max_depth < -1 || o.max_depth == 0) throw std::invalid_argument("max_depth must be -1 or >= 1");
         if (o.rr_depth < 1) throw std::invalid_argument("rr_depth must be >= 1");
-        const bool needs_map = light_sampler_needs_visibility_map(o.light_sampler);
+        const bool needs_map = light_sampler_needs_visibility_map(o.light_sampler) || o.within_light != "own";
         if (o.light_sampler.rfind("spatial", 0) == 0 || needs_map || options.get_string("shadow_rays", "nee") != "nee")
             o.voxels = options.get_int("voxels", o.voxels);
         // A light sampler reading the map needs it from the first pass: no deferred seeding then.

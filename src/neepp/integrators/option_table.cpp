@@ -52,6 +52,9 @@ std::vector<IntegratorDoc> make_docs() {
                        common(p.max_depth, p.rr_depth, p.hide_emitters)};
     path.options.push_back({"nee", text(p.nee), "next event estimation (false: BSDF sampling only, the paper's Path)", ""});
     path.options.push_back({"light_sampler", p.light_sampler, "which light NEE samples: " + samplers, ""});
+    path.options.push_back({"within_light", p.within_light,
+                            "where on it: own (the light's own sampling) or visibility (environment maps per "
+                            "shading voxel by the visibility map)", ""});
     for (OptionDoc o : shadow_ray_options()) {
         if (o.name == "voxels") o.description += " (also the grid of the spatial and visibility light samplers)";
         path.options.push_back(o);

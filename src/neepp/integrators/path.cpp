@@ -30,24 +30,28 @@ void PathIntegrator::prepare(const Scene &scene) {
     // The factory keeps a map for a sampler that may read one; on a scene where it does not (one light),
     // a map that no shadow-ray policy uses either is not built.
     if (shadow_->policy() == "nee" && shadow_->visibility_map() &&
-        !light_sampler_needs_visibility_map(options_.light_sampler, scene.lights().size()))
+        !light_sampler_needs_visibility_map(options_.light_sampler, scene.lights().size()) &&
+        options_.within_light == "own")
         shadow_ = std::make_unique<TraceAllShadowRays>();
     shadow_->prepare(scene);  // NEE++: build or load the visibility map
     queries_ = &shadow_->query_tester();
     LightSelectionInputs inputs{&scene, shadow_->voxel_grid(), shadow_->visibility_map(), options_.voxels};
     light_sampler_ = make_light_sampler(options_.light_sampler, scene.light_pointers(), inputs);
+    within_light_ = WithinLightSampling(options_.within_light, scene, shadow_->voxel_grid(), shadow_->visibility_map());
 }
 
 void PathIntegrator::end_pass(const Scene &, const PassStatistics &pass) {
     shadow_->end_pass(pass);     // NEE++: merge what the pass learned into the map the next pass reads
     queries_ = &shadow_->query_tester();  // ... or, its rejection off, leave the queries to plain NEE
     light_sampler_->end_pass();  // ... and rebuild the light distributions that read it
+    within_light_.end_pass();
 }
 
 void PathIntegrator::restore_state(const Scene &, const std::string &state) {
     shadow_->restore_state(state);
     queries_ = &shadow_->query_tester();
     light_sampler_->end_pass();  // its distributions read the restored map
+    within_light_.end_pass();
 }
 
 nlohmann::json PathIntegrator::statistics() const {
@@ -58,6 +62,7 @@ nlohmann::json PathIntegrator::statistics() const {
         l["used"] = light_sampler_->name();  // "power" whatever was asked when the scene has one light
         out["light_sampler"] = l;
     }
+    if (within_light_.any()) out["within_light"] = within_light_.statistics();
     return out;
 }
 
@@ -68,6 +73,7 @@ nlohmann::json PathIntegrator::describe() const {
             {"hide_emitters", options_.hide_emitters},
             {"nee", options_.nee},
             {"light_sampler", options_.light_sampler},
+            {"within_light", options_.within_light},
             {"shadow_rays", shadow_->policy()},
             {"shadow_ray_options", shadow_->describe()}};
 }
@@ -75,7 +81,8 @@ nlohmann::json PathIntegrator::describe() const {
 float PathIntegrator::emission_weight(const Light &light, const LightSampleContext &prev, const DirectionSample &ds,
                                       float prev_pdf) const {
     if (!options_.nee) return 1.f;
-    float light_pdf = light_sampler_->pmf(prev, light) * light.pdf_direction(prev.p, ds);
+    const ContextLightSampler *within = within_light_.for_light(light);
+    float light_pdf = light_sampler_->pmf(prev, light) * (within ? within->pdf(prev, ds) : light.pdf_direction(prev.p, ds));
     return mis_power(prev_pdf, light_pdf);
 }
 
@@ -94,6 +101,7 @@ struct PathIntegrator::Path {
     LightSampleContext ctx;
     bool nee = false;
     SampledLight light;
+    const ContextLightSampler *within = nullptr;  // samples points of the light, if not the light itself
     LightSampleStart light_start;  // begun by begin_light, from the light's variates
     LightSample light_sample;  // taken by sample_light, alone or in lanes
     // Next event estimation's shadow query, while its ray waits to be traced with the batch's others.
@@ -148,21 +156,27 @@ bool PathIntegrator::begin_vertex(const Scene &scene, Path &path) const {
     path.nee = options_.nee && (si.shape->bsdf_flags & BSDFSmooth);
     if (path.nee) {
         path.light = light_sampler_->sample(path.ctx, path.sampler->next_1d());
+        path.within = path.light.light ? within_light_.for_light(*path.light.light) : nullptr;
         path.light_start.u = path.sampler->next_2d();
-        if (path.light.light) path.light.light->prefetch_sample(path.light_start.u);
+        if (path.within) path.within->prefetch(path.ctx, path.light_start.u);
+        else if (path.light.light) path.light.light->prefetch_sample(path.light_start.u);
     }
     return true;
 }
 
 void PathIntegrator::begin_light(Path &path) const {
-    if (path.nee && path.light.light) path.light_start = path.light.light->begin_sample(path.light_start.u);
+    if (!path.nee || !path.light.light) return;
+    path.light_start = path.within ? path.within->begin(path.ctx, path.light_start.u)
+                                   : path.light.light->begin_sample(path.light_start.u);
 }
 
 void PathIntegrator::sample_light(Path &path, LightSampleLanes &lanes) const {
     const SampledLight &sl = path.light;
     path.nee = path.nee && sl.light && sl.pmf > 0;  // from here on: whether there is a sample to use
     if (!path.nee) return;
-    if (const LightLaneRecord *record = sl.light->lane_record())
+    if (path.within)
+        path.light_sample.ds = path.within->finish(path.ctx, path.light_start, path.light_sample.radiance);
+    else if (const LightLaneRecord *record = sl.light->lane_record())
         lanes.add(*record, path.si.p, path.light_start.u, path.light_sample);
     else
         path.light_sample.ds = sl.light->finish_sample(path.si.p, path.light_start, path.light_sample.radiance);

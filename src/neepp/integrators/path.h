@@ -5,6 +5,7 @@
 #pragma once
 #include <memory>
 #include "neepp/integrators/integrator.h"
+#include "neepp/light_selection/within_light_sampling.h"
 #include "neepp/lights/light_sampler.h"
 #include "neepp/visibility/shadow_ray_tester.h"
 
@@ -18,6 +19,7 @@ struct PathOptions {
     bool hide_emitters = false;
     bool nee = true;
     std::string light_sampler = "power";
+    std::string within_light = "own";  // how a point on the chosen light is sampled (WithinLightSampling)
     int voxels = 16;  // grid of the spatial light sampler when NEE++ keeps no map (else the map's grid)
 };
 
@@ -73,6 +75,7 @@ private:
     std::unique_ptr<ShadowRayTester> shadow_;
     const ShadowRayTester *queries_ = nullptr;  // shadow_->query_tester() for the coming pass
     std::unique_ptr<LightSampler> light_sampler_;
+    WithinLightSampling within_light_;
 };
 
 }  // namespace neepp

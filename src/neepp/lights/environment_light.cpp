@@ -193,24 +193,30 @@ Vec2 EnvironmentMapLight::sample_uv(Vec2 u, float &pdf_uv) const {
 LightSampleStart EnvironmentMapLight::begin_sample(Vec2 u) const {
     LightSampleStart start{u};
     start.point = sample_uv(u, start.density);
+    prefetch_lookup(start.point);
+    return start;
+}
+
+void EnvironmentMapLight::prefetch_lookup(Vec2 uv) const {
     // lookup(uv)'s bilinear footprint, which finish_sample reads: in each of its two texel rows, the first
     // and the last byte loaded (two texels and a half, 14 bytes, cross a cache line one time in five, and
     // with the first line only prefetched, misses on the second are a large part of lookup's time).
-    const int x = std::min(int(start.point.x * float(width_)), width_ - 1);
-    const int y = std::min(int(start.point.y * float(height_ - 1)), height_ - 1), y1 = std::min(y + 1, height_ - 1);
+    const int x = std::min(int(uv.x * float(width_)), width_ - 1);
+    const int y = std::min(int(uv.y * float(height_ - 1)), height_ - 1), y1 = std::min(y + 1, height_ - 1);
     for (int row : {y, y1}) {
         const size_t i = 3 * (size_t(row) * width_ + x);
         // (the last byte's index is clamped: past a row's end the footprint wraps, past the map's it stops)
         if (!half_.empty()) __builtin_prefetch(&half_[i]), __builtin_prefetch(&half_[std::min(i + 6, half_.size() - 1)]);
         else __builtin_prefetch(&float_[i]), __builtin_prefetch(&float_[std::min(i + 5, float_.size() - 1)]);
     }
-    return start;
 }
 
 DirectionSample EnvironmentMapLight::finish_sample(const Vec3 &ref, const LightSampleStart &start,
                                                    Color &radiance) const {
-    const Vec2 uv = start.point;
-    const float pdf_uv = start.density;
+    return direction_from_uv(ref, start.point, start.density, radiance);
+}
+
+DirectionSample EnvironmentMapLight::direction_from_uv(const Vec3 &ref, Vec2 uv, float pdf_uv, Color &radiance) const {
     DirectionSample ds;
     radiance = Color(0.f);
     if (pdf_uv <= 0) return ds;
@@ -230,12 +236,8 @@ DirectionSample EnvironmentMapLight::sample_direction(const Vec3 &ref, Vec2 u, C
 }
 
 float EnvironmentMapLight::pdf_direction(const Vec3 &, const DirectionSample &ds) const {
-    Vec2 uv = direction_to_uv(ds.d);
-    float sin_theta = std::sin(uv.y * kPi);
-    if (sin_theta <= 0) return 0.f;
-    const int w = sample_w_, h = sample_h_;
-    int x = std::min(int(uv.x * float(w)), w - 1), y = std::min(int(uv.y * float(h)), h - 1);
-    return cells_.pmf(uint32_t(y) * w + x) * float(w) * float(h) / (2.f * kPi * kPi * sin_theta);
+    const Vec2 uv = direction_to_uv(ds.d);
+    return solid_angle_density(uv, cells_.pmf(sampling_cell(uv)) * float(sample_w_) * float(sample_h_));
 }
 
 Color EnvironmentMapLight::power() const {

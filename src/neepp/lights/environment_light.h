@@ -1,6 +1,8 @@
 // Environment lights: Mitsuba's `envmap` (equirectangular, importance-sampled by luminance) and
 // `constant` (uniform radiance from every direction).
 #pragma once
+#include <algorithm>
+#include <cmath>
 #include <cstdint>
 #include <vector>
 #include "neepp/io/image.h"
@@ -42,6 +44,28 @@ public:
     Vec2 direction_to_uv(const Vec3 &d) const;
     // sin_theta (if given) receives the sine of the polar angle, which the direction's pdf divides by.
     Vec3 uv_to_direction(Vec2 uv, float *sin_theta = nullptr) const;
+
+    // Its sampling grid, for samplers that reweight it (NEE++'s per-voxel environment sampling): cells of
+    // sampling_width() × sampling_height() over uv (row-major, row 0 at v = 0), drawn from
+    // sampling_cells(), uniformly in uv within a cell.
+    int sampling_width() const { return sample_w_; }
+    int sampling_height() const { return sample_h_; }
+    const AliasTable &sampling_cells() const { return cells_; }
+    uint32_t sampling_cell(Vec2 uv) const {
+        const int x = std::min(int(uv.x * float(sample_w_)), sample_w_ - 1);
+        const int y = std::min(int(uv.y * float(sample_h_)), sample_h_ - 1);
+        return uint32_t(y) * uint32_t(sample_w_) + uint32_t(x);
+    }
+    // Cache prefetch of what direction_from_uv(uv) reads (a hint; never changes a result).
+    void prefetch_lookup(Vec2 uv) const;
+    // The direction sample of map point uv drawn with density pdf_uv (over uv), as sample_direction
+    // returns it: direction, solid-angle density, and the radiance arriving along it.
+    DirectionSample direction_from_uv(const Vec3 &ref, Vec2 uv, float pdf_uv, Color &radiance) const;
+    // The solid-angle density of direction uv's sample when its density over uv is pdf_uv.
+    static float solid_angle_density(Vec2 uv, float pdf_uv) {
+        const float sin_theta = std::sin(uv.y * kPi);
+        return sin_theta > 0 ? pdf_uv / (2.f * kPi * kPi * sin_theta) : 0.f;
+    }
 
 private:
     Color lookup(Vec2 uv) const;

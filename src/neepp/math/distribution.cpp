@@ -115,9 +115,9 @@ AliasTable::AliasTable(const std::vector<float> &weights) {
     for (Bin &b : bins_) b.alias_pmf = bins_[b.alias].pmf;
 }
 
-uint32_t AliasTable::sample(Vec2 u, Vec2 &offset, float *pmf_out) const {
+uint32_t AliasTable::sample_bits(uint64_t bits48, Vec2 &offset, float *pmf_out) const {
     double frac;
-    const uint32_t first = first_bin(u, frac);
+    const uint32_t first = first_bin(bits48, frac);
     const Bin &b = bins_[first];
     // Keep the bin, or jump to its alias: chosen by selects, not a branch, since which way it goes is
     // random (a branch is mispredicted about as often as the bins are split).

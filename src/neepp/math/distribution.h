@@ -61,19 +61,25 @@ public:
     // left over comes back in `offset` as a point uniform in [0,1)^2 to ~12 bits per axis, enough to
     // place a sample inside the chosen cell.
     // pmf_out (optional) receives the chosen index's pmf, read from the same cache line.
-    uint32_t sample(Vec2 u, Vec2 &offset, float *pmf_out = nullptr) const;
+    uint32_t sample(Vec2 u, Vec2 &offset, float *pmf_out = nullptr) const { return sample_bits(bits_of(u), offset, pmf_out); }
+    // The same from 48 random bits (a caller that spent some of u's bits on a choice of its own passes on
+    // what is left, rescaled, instead of a float variate with fewer bits than the table needs).
+    uint32_t sample_bits(uint64_t bits48, Vec2 &offset, float *pmf_out = nullptr) const;
+    // The 48 random bits sample(u) reads: the 24 mantissa bits of each sampler dimension.
+    static uint64_t bits_of(Vec2 u) {
+        return (uint64_t(double(u.x) * 0x1p24) << 24) | uint64_t(double(u.y) * 0x1p24);
+    }
     float pmf(uint32_t i) const { return bins_[i].pmf; }
     // Cache prefetch of the bin sample(u) reads first (a batched caller's latency hiding; a hint only).
-    void prefetch(Vec2 u) const {
+    void prefetch(Vec2 u) const { prefetch_bits(bits_of(u)); }
+    void prefetch_bits(uint64_t bits48) const {
         double frac;
-        __builtin_prefetch(&bins_[first_bin(u, frac)]);
+        __builtin_prefetch(&bins_[first_bin(bits48, frac)]);
     }
 
 private:
-    // The bin u picks before the alias test, and the fraction of it left for that test.
-    uint32_t first_bin(Vec2 u, double &frac) const {
-        // 48 random bits: the 24 mantissa bits of each sampler dimension.
-        const uint64_t bits = (uint64_t(double(u.x) * 0x1p24) << 24) | uint64_t(double(u.y) * 0x1p24);
+    // The bin 48 random bits pick before the alias test, and the fraction of it left for that test.
+    uint32_t first_bin(uint64_t bits, double &frac) const {
         const unsigned __int128 scaled = (unsigned __int128)bits * bins_.size();
         frac = double(uint64_t(scaled) & ((uint64_t(1) << 48) - 1)) * 0x1p-48;
         return uint32_t(scaled >> 48);
