@@ -1,0 +1,191 @@
+#!/usr/bin/env python3
+"""Every Mitsuba 3 scene under a folder, rendered by neepp and by Mitsuba 3 at low resolution: does it load,
+and does neepp's image agree?
+
+    .venv/bin/python bench/mitsuba_folder.py ~/mitsuba-tutorials/scenes
+    .venv/bin/python bench/mitsuba_folder.py ~/scenes --size 96 --spp 128 --variant llvm_ad_rgb
+
+A scene is every *.xml below the folder whose root is <scene>, except files another scene there
+<include>s (fragments). Each is rendered as published: its own integrator, sensor and sampler, only the
+resolution lowered and the sample count set. The resolution: where the scene declares `resx`/`resy`
+defaults they are passed as -D values; otherwise a copy of the file beside it (.lowres_NAME.xml,
+removed afterwards) gets a film whose largest side is --size, aspect ratio kept (crop windows scaled with
+it). Both renderers get that same file and --spp.
+
+Columns: loads (or neepp's first error), Mitsuba's own status, neepp's mean over Mitsuba's (sum of RGB),
+relMSE of neepp's image against Mitsuba's (both noisy, so it has a floor of about twice one render's
+relative variance) and the times. Writes bench/out/mitsuba_folder/ (git-ignored): images, results.json,
+table.md.
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import re
+import sys
+import xml.etree.ElementTree as ET
+from pathlib import Path
+
+import numpy as np
+
+REPO = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(REPO / "python"))
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+
+from mitsuba_suite import first_error, included_files  # noqa: E402
+from neepp_tools import metrics, report, runner  # noqa: E402
+
+DEFAULT_FILM = (768, 576)  # Mitsuba 3's hdrfilm when the scene gives no size
+
+
+def scenes_under(folder: Path) -> list[Path]:
+    """The scene files below folder: XML files whose root element is <scene> and that no other scene
+    file there includes."""
+    candidates = []
+    for f in sorted(folder.rglob("*.xml")):
+        if f.name.startswith(".lowres_"):
+            continue
+        try:
+            if ET.parse(f).getroot().tag == "scene":
+                candidates.append(f.resolve())
+        except ET.ParseError:
+            candidates.append(f.resolve())  # a renderer will say what is wrong with it
+    included = {g for f in candidates for g in included_files(f)[1:]}
+    return [f for f in candidates if f not in included]
+
+
+def defaults_of(root: ET.Element) -> dict[str, ET.Element]:
+    return {d.get("name"): d for d in root.iter("default")}
+
+
+def scaled_size(width: int, height: int, size: int) -> tuple[int, int]:
+    s = min(1.0, size / max(width, height))
+    return max(1, round(width * s)), max(1, round(height * s))
+
+
+def low_resolution(scene: Path, size: int) -> tuple[Path, dict, str]:
+    """(file to render, -D values, what was done). The file is the scene itself when it declares
+    resx/resy defaults (they become the -D values) or has no sensor of its own; otherwise a copy beside
+    it whose film is at most `size` pixels on its largest side."""
+    try:
+        root = ET.parse(scene).getroot()
+    except ET.ParseError:
+        return scene, {}, "as published"
+    defaults = defaults_of(root)
+    if "resx" in defaults and "resy" in defaults:
+        w, h = scaled_size(int(defaults["resx"].get("value")), int(defaults["resy"].get("value")), size)
+        return scene, {"resx": w, "resy": h}, f"-D resx={w} resy={h}"
+    sensor = root.find("sensor")
+    if sensor is None:
+        return scene, {}, "no sensor in the file: as published"
+    film = sensor.find("film")
+    if film is None:
+        film = ET.SubElement(sensor, "film", {"type": "hdrfilm"})
+
+    def prop(name):
+        return next((e for e in film.findall("integer") if e.get("name") == name), None)
+
+    def value(e, fallback):
+        if e is None:
+            return fallback, None
+        v = e.get("value", "")
+        if v.startswith("$") and v[1:] in defaults:  # a parameter: set its default instead
+            return int(defaults[v[1:]].get("value")), defaults[v[1:]]
+        return int(v), e
+
+    (w, we), (h, he) = value(prop("width"), DEFAULT_FILM[0]), value(prop("height"), DEFAULT_FILM[1])
+    nw, nh = scaled_size(w, h, size)
+    for name, e, v in (("width", we, nw), ("height", he, nh)):
+        if e is None:
+            e = ET.SubElement(film, "integer", {"name": name})
+        e.set("value", str(v))
+    s = nw / w
+    for e in film.findall("integer"):
+        if e.get("name", "").startswith("crop_") and not e.get("value", "").startswith("$"):
+            e.set("value", str(max(0 if "offset" in e.get("name") else 1, int(int(e.get("value")) * s))))
+    copy = scene.with_name(f".lowres_{scene.name}")
+    ET.ElementTree(root).write(copy, encoding="unicode")
+    return copy, {}, f"film {nw}x{nh}"
+
+
+def brief(error: str) -> str:
+    """An error for the table: without the list of what is supported."""
+    return re.sub(r" \(supported: [^)]*\)", "", error)
+
+
+def compare(img, ref) -> dict:
+    mref = float(np.sum(ref[..., :3], dtype=np.float64))
+    return {"mean_ratio": float(np.sum(img[..., :3], dtype=np.float64)) / mref if mref else float("nan"),
+            "relmse": metrics.relmse(img, ref)}
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("folder")
+    ap.add_argument("--size", type=int, default=128, help="largest side of the film, in pixels")
+    ap.add_argument("--spp", type=int, default=64)
+    ap.add_argument("--variant", default="", help="Mitsuba 3 variant (default llvm_ad_rgb where libLLVM is there: "
+                    "it has the differentiable integrators scalar_rgb lacks; else scalar_rgb)")
+    ap.add_argument("--threads", type=int, default=0)
+    ap.add_argument("--timeout", type=float, default=900, help="seconds per render")
+    ap.add_argument("--out", default=str(REPO / "bench" / "out" / "mitsuba_folder"))
+    a = ap.parse_args(argv)
+    a.variant = a.variant or ("llvm_ad_rgb" if runner.mitsuba_available("llvm_ad_rgb")[0] else "scalar_rgb")
+    folder = Path(a.folder).expanduser().resolve()
+    out = Path(a.out)
+    out.mkdir(parents=True, exist_ok=True)
+
+    rows, results = [], []
+    for scene in scenes_under(folder):
+        name = str(scene.relative_to(folder))
+        stem = re.sub(r"[^\w.-]", "_", name[:-4])
+        target, defines, how = low_resolution(scene, a.size)
+        rec = {"scene": name, "resolution": how}
+        neepp_img = mitsuba_img = None
+        try:
+            try:
+                r = runner.run_neepp(target, out / f"{stem}_neepp.exr", spp=a.spp, seed=1, defines=defines,
+                                     threads=a.threads or None, timeout=a.timeout)
+                neepp_img = r.image
+                rec.update(loads="yes", neepp_s=r.wall_s)
+            except runner.RenderError as e:
+                rec["loads"] = first_error(str(e), target.parent).replace(target.name, scene.name)
+            try:
+                m = runner.run_mitsuba(target, out / f"{stem}_mitsuba.exr", variant=a.variant, spp=a.spp, seed=0,
+                                       defines=defines, threads=a.threads, timeout=a.timeout, as_published=True)
+                mitsuba_img = m.image
+                rec.update(mitsuba="yes", mitsuba_s=m.wall_s)
+            except runner.RenderError as e:
+                rec["mitsuba"] = first_error(str(e), target.parent).replace(target.name, scene.name)
+        finally:
+            if target != scene:
+                target.unlink(missing_ok=True)
+        if neepp_img is not None and mitsuba_img is not None:
+            if neepp_img.shape == mitsuba_img.shape:
+                rec.update(compare(neepp_img, mitsuba_img))
+            else:
+                rec["note"] = f"sizes differ: neepp {neepp_img.shape[:2]}, Mitsuba {mitsuba_img.shape[:2]}"
+        results.append(rec)
+        print(json.dumps(rec), flush=True)
+        rows.append({"scene": name, "loads": brief(rec["loads"]), "Mitsuba 3": brief(rec["mitsuba"]),
+                     "mean ratio": f"{rec['mean_ratio']:.4f}" if "mean_ratio" in rec else rec.get("note"),
+                     "relMSE": f"{rec['relmse']:.4f}" if "relmse" in rec else None,
+                     "neepp s": f"{rec['neepp_s']:.1f}" if "neepp_s" in rec else None,
+                     "Mitsuba s": f"{rec['mitsuba_s']:.1f}" if "mitsuba_s" in rec else None,
+                     "resolution": how})
+
+    table = report.markdown_table(rows)
+    both = [r for r in results if "mean_ratio" in r]
+    summary = (f"{len(results)} scenes: neepp loads {sum(r['loads'] == 'yes' for r in results)}, Mitsuba 3 "
+               f"{sum(r['mitsuba'] == 'yes' for r in results)}; of the {len(both)} both render, "
+               f"{sum(abs(r['mean_ratio'] - 1) <= 0.02 for r in both)} have the mean within 2 % "
+               f"({a.spp} spp, largest side {a.size}, Mitsuba {a.variant})")
+    (out / "results.json").write_text(json.dumps(results, indent=2))
+    (out / "table.md").write_text(table + "\n\n" + summary + "\n")
+    print(table)
+    print(summary)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
