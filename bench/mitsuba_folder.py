@@ -54,58 +54,88 @@ def scenes_under(folder: Path) -> list[Path]:
     return [f for f in candidates if f not in included]
 
 
-def defaults_of(root: ET.Element) -> dict[str, ET.Element]:
-    return {d.get("name"): d for d in root.iter("default")}
-
-
 def scaled_size(width: int, height: int, size: int) -> tuple[int, int]:
     s = min(1.0, size / max(width, height))
     return max(1, round(width * s)), max(1, round(height * s))
 
 
-def low_resolution(scene: Path, size: int) -> tuple[Path, dict, str]:
-    """(file to render, -D values, what was done). The file is the scene itself when it declares
-    resx/resy defaults (they become the -D values) or has no sensor of its own; otherwise a copy beside
-    it whose film is at most `size` pixels on its largest side."""
+def sensor_chain(scene: Path, seen=None) -> list[tuple[Path, ET.Element, ET.Element | None]] | None:
+    """[(file, its parsed root, the <include> element that leads on)] from the scene down to the file
+    whose top level declares the first <sensor>, or None when no file does."""
+    seen = seen if seen is not None else set()
+    if scene in seen or not scene.is_file():
+        return None
+    seen.add(scene)
     try:
         root = ET.parse(scene).getroot()
     except ET.ParseError:
-        return scene, {}, "as published"
-    defaults = defaults_of(root)
+        return None
+    for e in root:
+        if e.tag == "sensor":
+            return [(scene, root, None)]
+        if e.tag == "include" and e.get("filename"):
+            rest = sensor_chain((scene.parent / e.get("filename")).resolve(), seen)
+            if rest:
+                return [(scene, root, e)] + rest
+    return None
+
+
+def all_defaults(scene: Path) -> dict[str, str]:
+    out = {}
+    for f in included_files(scene.resolve()):
+        try:
+            for d in ET.parse(f).getroot().iter("default"):
+                out.setdefault(d.get("name"), d.get("value"))
+        except ET.ParseError:
+            pass
+    return out
+
+
+def low_resolution(scene: Path, size: int) -> tuple[Path, dict, str, list[Path]]:
+    """(file to render, -D values, what was done, copies to remove afterwards). Where the scene declares
+    resx/resy defaults they become -D values, as does a parameter the film's width or height names;
+    otherwise the film of the first sensor (in the scene or a file it includes) is rewritten in copies
+    (.lowres_NAME.xml beside each file on the way to it) to at most `size` pixels on its largest side."""
+    defaults = all_defaults(scene)
     if "resx" in defaults and "resy" in defaults:
-        w, h = scaled_size(int(defaults["resx"].get("value")), int(defaults["resy"].get("value")), size)
-        return scene, {"resx": w, "resy": h}, f"-D resx={w} resy={h}"
-    sensor = root.find("sensor")
-    if sensor is None:
-        return scene, {}, "no sensor in the file: as published"
+        w, h = scaled_size(int(defaults["resx"]), int(defaults["resy"]), size)
+        return scene, {"resx": w, "resy": h}, f"-D resx={w} resy={h}", []
+    chain = sensor_chain(scene.resolve())
+    if not chain:
+        return scene, {}, "no sensor found: as published", []
+    sensor = chain[-1][1].find("sensor")
     film = sensor.find("film")
     if film is None:
         film = ET.SubElement(sensor, "film", {"type": "hdrfilm"})
+    props = {e.get("name"): e for e in film.findall("integer")}
 
-    def prop(name):
-        return next((e for e in film.findall("integer") if e.get("name") == name), None)
-
-    def value(e, fallback):
+    def current(name, fallback):
+        e = props.get(name)
         if e is None:
-            return fallback, None
+            return fallback
         v = e.get("value", "")
-        if v.startswith("$") and v[1:] in defaults:  # a parameter: set its default instead
-            return int(defaults[v[1:]].get("value")), defaults[v[1:]]
-        return int(v), e
+        return int(defaults.get(v[1:], fallback)) if v.startswith("$") else int(v)
 
-    (w, we), (h, he) = value(prop("width"), DEFAULT_FILM[0]), value(prop("height"), DEFAULT_FILM[1])
+    w, h = current("width", DEFAULT_FILM[0]), current("height", DEFAULT_FILM[1])
     nw, nh = scaled_size(w, h, size)
-    for name, e, v in (("width", we, nw), ("height", he, nh)):
+    defines = {}
+    for name, v in (("width", nw), ("height", nh)):
+        e = props.get(name)
         if e is None:
-            e = ET.SubElement(film, "integer", {"name": name})
-        e.set("value", str(v))
-    s = nw / w
-    for e in film.findall("integer"):
-        if e.get("name", "").startswith("crop_") and not e.get("value", "").startswith("$"):
-            e.set("value", str(max(0 if "offset" in e.get("name") else 1, int(int(e.get("value")) * s))))
-    copy = scene.with_name(f".lowres_{scene.name}")
-    ET.ElementTree(root).write(copy, encoding="unicode")
-    return copy, {}, f"film {nw}x{nh}"
+            ET.SubElement(film, "integer", {"name": name, "value": str(v)})
+        elif e.get("value", "").startswith("$"):
+            defines[e.get("value")[1:]] = v
+        else:
+            e.set("value", str(v))
+    for name, e in props.items():
+        if name.startswith("crop_") and not e.get("value", "").startswith("$"):
+            e.set("value", str(max(0 if "offset" in name else 1, int(int(e.get("value")) * nw / w))))
+    copies = [f.with_name(f".lowres_{f.name}") for f, _, _ in chain]
+    for (f, root, include), copy, nxt in zip(chain, copies, copies[1:] + [None]):
+        if include is not None:
+            include.set("filename", str(Path(include.get("filename")).with_name(nxt.name)))
+        ET.ElementTree(root).write(copy, encoding="unicode")
+    return copies[0], defines, f"film {nw}x{nh}" + (f" (-D {defines})" if defines else ""), copies
 
 
 def brief(error: str) -> str:
@@ -135,56 +165,72 @@ def main(argv=None) -> int:
     out = Path(a.out)
     out.mkdir(parents=True, exist_ok=True)
 
-    rows, results = [], []
+    results = []
     for scene in scenes_under(folder):
-        name = str(scene.relative_to(folder))
-        stem = re.sub(r"[^\w.-]", "_", name[:-4])
-        target, defines, how = low_resolution(scene, a.size)
-        rec = {"scene": name, "resolution": how}
-        neepp_img = mitsuba_img = None
-        try:
-            try:
-                r = runner.run_neepp(target, out / f"{stem}_neepp.exr", spp=a.spp, seed=1, defines=defines,
-                                     threads=a.threads or None, timeout=a.timeout)
-                neepp_img = r.image
-                rec.update(loads="yes", neepp_s=r.wall_s)
-            except runner.RenderError as e:
-                rec["loads"] = first_error(str(e), target.parent).replace(target.name, scene.name)
-            try:
-                m = runner.run_mitsuba(target, out / f"{stem}_mitsuba.exr", variant=a.variant, spp=a.spp, seed=0,
-                                       defines=defines, threads=a.threads, timeout=a.timeout, as_published=True)
-                mitsuba_img = m.image
-                rec.update(mitsuba="yes", mitsuba_s=m.wall_s)
-            except runner.RenderError as e:
-                rec["mitsuba"] = first_error(str(e), target.parent).replace(target.name, scene.name)
-        finally:
-            if target != scene:
-                target.unlink(missing_ok=True)
-        if neepp_img is not None and mitsuba_img is not None:
-            if neepp_img.shape == mitsuba_img.shape:
-                rec.update(compare(neepp_img, mitsuba_img))
-            else:
-                rec["note"] = f"sizes differ: neepp {neepp_img.shape[:2]}, Mitsuba {mitsuba_img.shape[:2]}"
+        rec = render_both(scene, folder, a, out)
         results.append(rec)
         print(json.dumps(rec), flush=True)
-        rows.append({"scene": name, "loads": brief(rec["loads"]), "Mitsuba 3": brief(rec["mitsuba"]),
-                     "mean ratio": f"{rec['mean_ratio']:.4f}" if "mean_ratio" in rec else rec.get("note"),
-                     "relMSE": f"{rec['relmse']:.4f}" if "relmse" in rec else None,
-                     "neepp s": f"{rec['neepp_s']:.1f}" if "neepp_s" in rec else None,
-                     "Mitsuba s": f"{rec['mitsuba_s']:.1f}" if "mitsuba_s" in rec else None,
-                     "resolution": how})
 
-    table = report.markdown_table(rows)
-    both = [r for r in results if "mean_ratio" in r]
-    summary = (f"{len(results)} scenes: neepp loads {sum(r['loads'] == 'yes' for r in results)}, Mitsuba 3 "
-               f"{sum(r['mitsuba'] == 'yes' for r in results)}; of the {len(both)} both render, "
-               f"{sum(abs(r['mean_ratio'] - 1) <= 0.02 for r in both)} have the mean within 2 % "
-               f"({a.spp} spp, largest side {a.size}, Mitsuba {a.variant})")
+    table = report.markdown_table([table_row(r) for r in results])
+    summary = summary_of(results) + f" ({a.spp} spp, largest side {a.size}, Mitsuba {a.variant})"
     (out / "results.json").write_text(json.dumps(results, indent=2))
     (out / "table.md").write_text(table + "\n\n" + summary + "\n")
     print(table)
     print(summary)
     return 0
+
+
+def render_both(scene: Path, folder: Path, a, out: Path) -> dict:
+    """The scene's record: whether each renderer loads it (or its first error), and how the images compare."""
+    name = str(scene.relative_to(folder))
+    stem = re.sub(r"[^\w.-]", "_", name[:-4])
+    target, defines, how, copies = low_resolution(scene, a.size)
+    rec = {"scene": name, "resolution": how}
+
+    def error(e):  # the copies' names are the originals' with a prefix
+        return first_error(str(e), target.parent).replace(".lowres_", "")
+
+    neepp_img = mitsuba_img = None
+    try:
+        try:
+            r = runner.run_neepp(target, out / f"{stem}_neepp.exr", spp=a.spp, seed=1, defines=defines,
+                                 threads=a.threads or None, timeout=a.timeout)
+            neepp_img = r.image
+            rec.update(loads="yes", neepp_s=r.wall_s)
+        except runner.RenderError as e:
+            rec["loads"] = error(e)
+        try:
+            m = runner.run_mitsuba(target, out / f"{stem}_mitsuba.exr", variant=a.variant, spp=a.spp, seed=0,
+                                   defines=defines, threads=a.threads, timeout=a.timeout, as_published=True)
+            mitsuba_img = m.image
+            rec.update(mitsuba="yes", mitsuba_s=m.wall_s)
+        except runner.RenderError as e:
+            rec["mitsuba"] = error(e)
+    finally:
+        for c in copies:
+            c.unlink(missing_ok=True)
+    if neepp_img is not None and mitsuba_img is not None:
+        if neepp_img.shape == mitsuba_img.shape:
+            rec.update(compare(neepp_img, mitsuba_img))
+        else:
+            rec["note"] = f"sizes differ: neepp {neepp_img.shape[:2]}, Mitsuba {mitsuba_img.shape[:2]}"
+    return rec
+
+
+def table_row(rec: dict) -> dict:
+    def num(key, digits):
+        return f"{rec[key]:.{digits}f}" if key in rec else None
+
+    return {"scene": rec["scene"], "loads": brief(rec["loads"]), "Mitsuba 3": brief(rec["mitsuba"]),
+            "mean ratio": num("mean_ratio", 4) or rec.get("note"), "relMSE": num("relmse", 4),
+            "neepp s": num("neepp_s", 1), "Mitsuba s": num("mitsuba_s", 1), "resolution": rec["resolution"]}
+
+
+def summary_of(results: list[dict]) -> str:
+    both = [r for r in results if "mean_ratio" in r]
+    return (f"{len(results)} scenes: neepp loads {sum(r['loads'] == 'yes' for r in results)}, Mitsuba 3 "
+            f"{sum(r['mitsuba'] == 'yes' for r in results)}; of the {len(both)} both render, "
+            f"{sum(abs(r['mean_ratio'] - 1) <= 0.02 for r in both)} have the mean within 2 %")
 
 
 if __name__ == "__main__":
