@@ -80,6 +80,11 @@ def sensor_chain(scene: Path, seen=None) -> list[tuple[Path, ET.Element, ET.Elem
     return None
 
 
+def uses_parameter(scene: Path, name: str) -> bool:
+    pattern = re.compile(r"\$" + re.escape(name) + r"\b")
+    return any(pattern.search(f.read_text(errors="replace")) for f in included_files(scene.resolve()))
+
+
 def all_defaults(scene: Path) -> dict[str, str]:
     out = {}
     for f in included_files(scene.resolve()):
@@ -152,6 +157,7 @@ def compare(img, ref) -> dict:
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("folder")
+    ap.add_argument("--scenes", default="", help="comma-separated substrings of the scene paths to run")
     ap.add_argument("--size", type=int, default=128, help="largest side of the film, in pixels")
     ap.add_argument("--spp", type=int, default=64)
     ap.add_argument("--variant", default="", help="Mitsuba 3 variant (default llvm_ad_rgb where libLLVM is there: "
@@ -166,7 +172,10 @@ def main(argv=None) -> int:
     out.mkdir(parents=True, exist_ok=True)
 
     results = []
+    wanted = [w for w in a.scenes.split(",") if w]
     for scene in scenes_under(folder):
+        if wanted and not any(w in str(scene.relative_to(folder)) for w in wanted):
+            continue
         rec = render_both(scene, folder, a, out)
         results.append(rec)
         print(json.dumps(rec), flush=True)
@@ -185,6 +194,8 @@ def render_both(scene: Path, folder: Path, a, out: Path) -> dict:
     name = str(scene.relative_to(folder))
     stem = re.sub(r"[^\w.-]", "_", name[:-4])
     target, defines, how, copies = low_resolution(scene, a.size)
+    if uses_parameter(scene, "spp"):  # some scenes expect it from the command line, with no default
+        defines["spp"] = a.spp
     rec = {"scene": name, "resolution": how}
 
     def error(e):  # the copies' names are the originals' with a prefix
