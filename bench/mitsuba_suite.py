@@ -31,7 +31,6 @@ import argparse
 import json
 import os
 import re
-import subprocess
 import sys
 from pathlib import Path
 
@@ -113,25 +112,6 @@ def judge(img_rgb, spp: int, ref_rgb, ref_var_rgb) -> dict:
             "mean_ratio": float(np.sum(img_rgb[..., :3], dtype=np.float64)) / mref if mref else float("nan"),
             "mean_z2": metrics.mean_z_squared(img, spp, ref, var),
             "passed": frac >= PASS_FRACTION}
-
-
-MITSUBA_RENDER = """
-import os, sys, numpy as np, mitsuba as mi
-mi.set_variant('scalar_rgb')
-scene, out, spp, integrator = sys.argv[1], sys.argv[2], int(sys.argv[3]), sys.argv[4]
-s = mi.load_file(scene, spp=spp, integrator=integrator)
-img = np.array(mi.render(s, seed=0, spp=spp))[..., :3]
-mi.Bitmap(np.ascontiguousarray(img, dtype=np.float32), mi.Bitmap.PixelFormat.RGB).write(out)
-os._exit(0)
-"""
-
-
-def render_mitsuba(scene: Path, out: Path, spp: int, integrator: str, timeout: float):
-    r = subprocess.run([runner.mitsuba_python(), "-c", MITSUBA_RENDER, str(scene), str(out), str(spp), integrator],
-                       capture_output=True, text=True, timeout=timeout)
-    if r.returncode != 0 or not out.exists():
-        raise runner.RenderError(r.stdout + r.stderr)
-    return exr.read_exr(out)
 
 
 def table_row(rec: dict, with_mitsuba: bool) -> dict:
@@ -223,9 +203,11 @@ def run_scene(scene, ref_path, var_path, rec, a, options, out, folder):
         rec.update(status="error", error=first_error(str(e), folder))
     if a.mitsuba:
         try:
-            img = render_mitsuba(scene, out / f"{stem}_mitsuba.exr", spp, rec["integrator"], a.timeout)
-            rec["mitsuba"] = judge(img, spp, ref, var)
-        except (runner.RenderError, subprocess.TimeoutExpired) as e:
+            m = runner.run_mitsuba(scene, out / f"{stem}_mitsuba.exr", variant="scalar_rgb", spp=spp, seed=0,
+                                   defines={"spp": spp, "integrator": rec["integrator"]}, as_published=True,
+                                   timeout=a.timeout)
+            rec["mitsuba"] = judge(m.image, spp, ref, var)
+        except runner.RenderError as e:
             rec["mitsuba"] = {"error": first_error(str(e), folder)}
 
 
