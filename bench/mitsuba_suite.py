@@ -21,7 +21,10 @@ neepp renders with the build's binary (NEEPP_BIN or build/neepp). --scale F rend
 sample count (the test stays valid, it only loses power); scenes with participating media are listed as
 out of scope. Columns: loads (or the first error), the pass fraction, neepp's mean over the reference's
 (sum of RGB), and mean z^2, which for an unbiased render estimates neepp's per-sample variance over the
-reference's. --mitsuba adds the same columns for Mitsuba 3 (pip, scalar_rgb) as a control.
+reference's. --mitsuba adds the same columns for Mitsuba 3 (pip, scalar_rgb) as a control. Mitsuba 3
+chooses among emitters uniformly (or by their sampling_weight) where neepp's path tracer defaults to their
+power: on scenes with several lights `-I light_sampler=uniform` makes the noise, and so mean z^2,
+comparable with Mitsuba's.
 
 Writes bench/out/mitsuba_suite/ (git-ignored): the renders, results.json and table.md.
 """
