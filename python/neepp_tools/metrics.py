@@ -14,7 +14,8 @@ EPS = 0.01
 
 __all__ = ["EPS", "downsample", "relmse_map", "relmse", "relative_variance", "rmse", "mean_abs_rel_error",
            "image_mean", "mean_stderr", "relmse_stderr", "block_z_scores", "block_agreement", "all_metrics",
-           "paired_ratios"]
+           "paired_ratios", "RGB_TO_XYZ", "rgb_to_xyz", "sidak_alpha", "pixel_z_test_pvalues", "z_test_pass_fraction",
+           "mean_z_squared"]
 
 
 def _pair(img, ref):
@@ -164,3 +165,52 @@ def paired_ratios(ratios) -> dict:
     p = sum(math.comb(n, k) for k in range(above, n + 1)) / 2**n
     return {"n": n, "median": float(np.median(rs)), "geomean": math.exp(sum(map(math.log, rs)) / n),
             "above_1": above, "sign_test_p": p}
+
+
+# Linear Rec. 709 RGB to CIE XYZ with the coefficients of Mitsuba 3's srgb_to_xyz: its render tests compare
+# images in XYZ, and a variance image written as RGB goes back to XYZ through the same matrix.
+RGB_TO_XYZ = np.array([[0.412453, 0.357580, 0.180423],
+                       [0.212671, 0.715160, 0.072169],
+                       [0.019334, 0.119193, 0.950227]])
+
+_erfc = np.vectorize(math.erfc, otypes=[np.float64])
+
+
+def rgb_to_xyz(img) -> np.ndarray:
+    return np.asarray(img, dtype=np.float64)[..., :3] @ RGB_TO_XYZ.T
+
+
+def sidak_alpha(level: float, tests: int) -> float:
+    """Per-test significance that keeps the chance of any false rejection among `tests` independent
+    tests at `level` (Šidák)."""
+    return 1.0 - (1.0 - level) ** (1.0 / tests)
+
+
+def _z(mean, spp: int, ref, ref_var, min_var: float):
+    # The floor keeps pixels the reference saw (nearly) no variance in from failing on rounding alone.
+    return np.abs(np.asarray(mean, np.float64) - ref) * np.sqrt(spp / np.maximum(ref_var, min_var))
+
+
+def pixel_z_test_pvalues(mean, spp: int, ref, ref_var, min_var: float = 1e-4) -> np.ndarray:
+    """Two-sided p-value, per pixel and channel, that `mean` (an average of spp independent samples) has
+    the expectation `ref`, where ref_var is the per-sample variance: the statistic of Mitsuba 3's render
+    tests (src/render/tests/test_renders.py), its variance floor included. A NaN pixel gets p = NaN,
+    which fails any test."""
+    return _erfc(_z(mean, spp, ref, ref_var, min_var) / math.sqrt(2.0))  # 2 (1 - Phi(z))
+
+
+def z_test_pass_fraction(mean, spp: int, ref, ref_var, level: float = 0.01, min_var: float = 1e-4) -> float:
+    """Fraction of pixel channels whose p-value exceeds the Šidák-corrected level over the pixel count.
+    Mitsuba 3 accepts a render when it is at least 0.9975."""
+    p = pixel_z_test_pvalues(mean, spp, ref, ref_var, min_var)
+    pixels = p.shape[0] * p.shape[1]
+    return float(np.count_nonzero(p > sidak_alpha(level, pixels)) / p.size)
+
+
+def mean_z_squared(mean, spp: int, ref, ref_var, min_var: float = 1e-4) -> float:
+    """Mean of z^2 over the pixel channels whose reference variance is above the floor. For an unbiased
+    `mean` it estimates (its per-sample variance) / (the reference's): 1 when both estimators are equally
+    noisy; bias adds to it."""
+    z = _z(mean, spp, ref, ref_var, min_var)
+    keep = np.asarray(ref_var) > min_var
+    return float(np.mean(np.square(z[keep]))) if keep.any() else float("nan")

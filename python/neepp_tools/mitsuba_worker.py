@@ -53,6 +53,9 @@ def main(argv=None) -> int:
     ap.add_argument("--threads", type=int, default=0)
     ap.add_argument("--define", action="append", default=[], metavar="NAME=VALUE",
                     help="scene parameter, as mitsuba's -D (repeatable)")
+    ap.add_argument("--as-published", action="store_true",
+                    help="pass the scene only the --define parameters and render its own integrator: Mitsuba 3 "
+                         "refuses parameters a scene does not use, and a published scene declares its own")
     a = ap.parse_args(argv)
 
     if a.variant.startswith("llvm") and "DRJIT_LIBLLVM_PATH" not in os.environ and os.path.exists(LLVM_DEFAULT):
@@ -69,11 +72,12 @@ def main(argv=None) -> int:
     t_import = time.perf_counter() - t0
 
     params = dict(d.split("=", 1) for d in a.define)
-    params |= {"spp": a.spp, "max_depth": a.max_depth, "integrator": a.integrator}
-    if a.resx:
-        params["resx"] = a.resx
-    if a.resy:
-        params["resy"] = a.resy
+    if not a.as_published:
+        params |= {"spp": a.spp, "max_depth": a.max_depth, "integrator": a.integrator}
+        if a.resx:
+            params["resx"] = a.resx
+        if a.resy:
+            params["resy"] = a.resy
     t1 = time.perf_counter()
     scene = mi.load_file(a.scene, **params)
     t_load = time.perf_counter() - t1
@@ -105,7 +109,7 @@ def main(argv=None) -> int:
         "renderer": "mitsuba3",
         "mitsuba_version": mi.__version__,
         "variant": a.variant,
-        "integrator": a.integrator,
+        "integrator": "the scene's" if a.as_published else a.integrator,
         "scene": os.path.abspath(a.scene),
         "width": w,
         "height": h,

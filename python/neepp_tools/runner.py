@@ -233,8 +233,11 @@ def run_mitsuba(scene, out_exr=None, *, variant: str = "llvm_ad_rgb", resx: int 
                 resy: int | None = None, spp: int = 16, max_depth: int = 17, seed: int = 0,
                 integrator: str = "path", spp_per_pass: int = 0, threads: int = 0,
                 defines: dict | None = None, timeout: float | None = None,
-                cache: bool | Path = False) -> RenderResult:
+                cache: bool | Path = False, as_published: bool = False) -> RenderResult:
     """Render scene with Mitsuba 3 in a child process; returns image + timing stats.
+
+    as_published=True passes the scene only `defines` (not resx/resy, max_depth, integrator) and renders
+    its own integrator, at spp.
 
     cache=True (or a directory) reuses a previous render with identical parameters, keyed by scene
     path/size/mtime and all render parameters; the image is then stored under the cache directory.
@@ -243,6 +246,8 @@ def run_mitsuba(scene, out_exr=None, *, variant: str = "llvm_ad_rgb", resx: int 
               seed=int(seed), integrator=integrator)
     if defines:  # only when given, so that the keys of existing cached renders stay valid
         kw["defines"] = {k: str(v) for k, v in defines.items()}
+    if as_published:
+        kw["as_published"] = True
     cache_dir = None
     if cache:
         cache_dir = Path(cache) if not isinstance(cache, bool) else CACHE_DIR
@@ -280,6 +285,8 @@ def run_mitsuba(scene, out_exr=None, *, variant: str = "llvm_ad_rgb", resx: int 
         cmd += ["--threads", str(int(threads))]
     for k, v in (defines or {}).items():
         cmd += ["--define", f"{k}={v}"]
+    if as_published:
+        cmd.append("--as-published")
     env = dict(os.environ)
     env["PYTHONPATH"] = os.pathsep.join([str(REPO_ROOT / "python")] +
                                         ([env["PYTHONPATH"]] if env.get("PYTHONPATH") else []))
