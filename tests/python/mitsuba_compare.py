@@ -46,8 +46,9 @@ def assert_agrees(img, ref, what, mean_tol: float = 0.01, region_tol: float = 0.
 def assert_blocks_agree(img, ref, what, block: int = 12, level: float = 0.01):
     """Every block x block tile passes a z-test of its pixel differences (Sidak-corrected, all tiles together
     failing with probability `level` when the images agree). assert_agrees's standard errors come from the
-    spread of the difference over tiles, which a structural difference inflates as well: a map read
-    mirrored can pass it; this test, whose variance is each tile's own, cannot."""
+    spread of the difference over tiles, which a structural difference inflates as well (a normal map read
+    mirrored can pass it); here each tile's variance comes from its own pixels, and a structural difference
+    shows as a shifted tile mean."""
     frac, z_crit, n = metrics.block_agreement(img[..., :3], ref[..., :3], block, level)
     z = metrics.block_z_scores(img[..., :3], ref[..., :3], block)
     assert frac == 1.0, (what, f"{n - round(frac * n)} of {n} blocks beyond |z| {z_crit:.2f}", z.round(1).tolist())
