@@ -2,6 +2,8 @@
 #include <gtest/gtest.h>
 #include <fstream>
 #include "neepp/io/scene_error.h"
+#include "neepp/materials/blendbsdf.h"
+#include "neepp/materials/normalmap.h"
 #include "neepp/materials/principled.h"
 #include "neepp/materials/principledthin.h"
 #include "test_scenes.h"
@@ -138,6 +140,45 @@ TEST(SceneLoader, PrincipledThinLoadsWithItsLobes) {
     EXPECT_FALSE(sheet->flags() & BSDFDiffuseTransmission);
     EXPECT_TRUE(sheet->needs_tangents());
     load_error(scene_with(std::string(kLight) + R"(<shape type="sphere"><bsdf type="principledthin"><float name="diffuse_reflectance_sampling_rate" value="0"/></bsdf></shape>)"));
+}
+
+// normalmap and blendbsdf: a missing normal map names its path, and each wrapper says what it lacks.
+TEST(SceneErrors, NormalMapAndBlendSayWhatIsMissing) {
+    std::string msg = load_error(scene_with(std::string(kLight) + R"(<shape type="rectangle"><bsdf type="normalmap">
+        <texture name="normalmap" type="bitmap"><string name="filename" value="textures/no_normals.png"/><boolean name="raw" value="true"/></texture>
+        <bsdf type="diffuse"/></bsdf></shape>)"));
+    EXPECT_NE(msg.find("textures/no_normals.png"), std::string::npos) << msg;
+    msg = load_error(scene_with(std::string(kLight) + R"(<shape type="rectangle"><bsdf type="normalmap"><bsdf type="diffuse"/></bsdf></shape>)"));
+    EXPECT_NE(msg.find("'normalmap'"), std::string::npos) << msg;
+    msg = load_error(scene_with(std::string(kLight) + R"(<shape type="rectangle"><bsdf type="normalmap"><rgb name="normalmap" value="0.5,0.5,1"/></bsdf></shape>)"));
+    EXPECT_NE(msg.find("needs 1 nested <bsdf>, found 0"), std::string::npos) << msg;
+    msg = load_error(scene_with(std::string(kLight) + R"(
+<shape type="rectangle"><bsdf type="blendbsdf"><float name="weight" value="0.3"/><bsdf type="diffuse"/></bsdf></shape>)"));
+    EXPECT_NE(msg.find(":4:"), std::string::npos) << msg;
+    EXPECT_NE(msg.find("needs 2 nested <bsdf>, found 1"), std::string::npos) << msg;
+    msg = load_error(scene_with(std::string(kLight) + R"(<shape type="rectangle"><bsdf type="blendbsdf"><bsdf type="diffuse"/><bsdf type="conductor"/></bsdf></shape>)"));
+    EXPECT_NE(msg.find("'weight'"), std::string::npos) << msg;
+}
+
+// Both load with their nested BSDFs, the blend's weight a float or a texture, and the normal map's flags.
+TEST(SceneLoader, NormalMapAndBlendLoad) {
+    auto load_bsdf = [](const std::string &bsdf) {
+        return load_scene(write_temp_scene(scene_with(std::string(kLight) + "<shape type=\"rectangle\">" + bsdf + "</shape>")))
+            ->shapes().at(0)->bsdf;
+    };
+    auto blend = load_bsdf(R"(<bsdf type="blendbsdf"><float name="weight" value="0.3"/><bsdf type="diffuse"/>
+        <bsdf type="roughconductor"><float name="alpha" value="0.2"/></bsdf></bsdf>)");
+    ASSERT_TRUE(std::dynamic_pointer_cast<const BlendBSDF>(blend));
+    EXPECT_EQ(blend->flags(), uint32_t(BSDFDiffuseReflection | BSDFGlossyReflection));
+    auto textured = load_bsdf(R"(<bsdf type="blendbsdf"><texture name="weight" type="checkerboard"/><bsdf type="diffuse"/>
+        <bsdf type="twosided"><bsdf type="conductor"/></bsdf></bsdf>)");
+    EXPECT_EQ(textured->flags(), uint32_t(BSDFDiffuseReflection | BSDFDeltaReflection));
+    auto normals = load_bsdf(R"(<bsdf type="normalmap"><rgb name="normalmap" value="0.6,0.5,0.9"/>
+        <boolean name="flip_invalid_normals" value="false"/><boolean name="use_shadowing_function" value="false"/>
+        <bsdf type="roughplastic"/></bsdf>)");
+    ASSERT_TRUE(std::dynamic_pointer_cast<const NormalMapBSDF>(normals));
+    EXPECT_TRUE(normals->needs_tangents());
+    EXPECT_TRUE(normals->flags() & BSDFGlossyReflection);
 }
 
 // Mitsuba's default BSDF is diffuse 0.5, except on an emitter, where it is black: a light without a BSDF

@@ -1,12 +1,17 @@
 // Chi-square goodness of fit of every non-delta BSDF's sampling against its pdf, over incident angles
-// from normal to grazing, roughness 0.05..0.8, both distributions, anisotropy and both normal samplers.
+// from normal to grazing, roughness 0.05..0.8, both distributions, anisotropy and both normal samplers,
+// and of the wrappers that sample a nested BSDF their own way (blendbsdf, normalmap).
 #include <gtest/gtest.h>
 
 #include <functional>
 #include <sstream>
 
 #include "chi2.h"
+#include "neepp/materials/blendbsdf.h"
+#include "neepp/materials/checkerboard_texture.h"
+#include "neepp/materials/conductor.h"
 #include "neepp/materials/diffuse.h"
+#include "neepp/materials/normalmap.h"
 #include "neepp/materials/plastic.h"
 #include "neepp/materials/roughconductor.h"
 #include "neepp/materials/roughplastic.h"
@@ -75,6 +80,42 @@ std::vector<Case> make_cases() {
                                                   nullptr, true, false);
     }, {45.f});
     add("plastic", [] { return std::make_shared<PlasticBSDF>(1.49f, 1.f, constant_texture(0.5f)); }, {10.f, 80.f});
+
+    // blendbsdf: the pick by weight and the blended pdf. A float weight, a texture one (the checkerboard's
+    // color0 at the harness's uv), and a delta lobe, whose samples the pdf leaves out, scaled by its pick.
+    auto glossy = [] {
+        auto a = constant_texture(0.2f);
+        return std::make_shared<RoughConductorBSDF>(MicrofacetType::GGX, a, a, constant_texture(0.2f), constant_texture(3.f));
+    };
+    auto diffuse = [] { return std::make_shared<DiffuseBSDF>(constant_texture(Color(0.8f, 0.5f, 0.3f))); };
+    add("blend_diffuse_roughconductor_w0.3", [=] {
+        return std::make_shared<BlendBSDF>(constant_texture(0.3f), diffuse(), glossy());
+    }, {0.f, 45.f, 80.f});
+    add("blend_textured_weight", [=] {
+        auto weight = std::make_shared<CheckerboardTexture>(constant_texture(0.7f), constant_texture(0.1f), Transform());
+        return std::make_shared<BlendBSDF>(weight, glossy(), diffuse());
+    }, {30.f});
+    add("blend_diffuse_mirror_w0.4", [=] {
+        return std::make_shared<BlendBSDF>(constant_texture(0.4f), diffuse(),
+                                           std::make_shared<ConductorBSDF>(constant_texture(0.f), constant_texture(1.f)));
+    }, {20.f});
+    // normalmap: a constant tilted tangent-space normal, (0.3, -0.2, 0.8) before normalization, with and
+    // without Mitsuba's two defaults; and one tilted away from these wi, (-0.6, -0.5, 0.3), which
+    // flip_invalid_normals mirrors except at normal incidence.
+    const Color tilted(0.65f, 0.4f, 0.9f), away(0.2f, 0.25f, 0.65f);
+    add("normalmap_diffuse", [=] { return std::make_shared<NormalMapBSDF>(constant_texture(tilted), diffuse()); },
+        {0.f, 50.f, 85.f});
+    add("normalmap_diffuse_flipped", [=] { return std::make_shared<NormalMapBSDF>(constant_texture(away), diffuse()); },
+        {0.f, 50.f, 85.f});
+    add("normalmap_roughplastic", [=] {
+        return std::make_shared<NormalMapBSDF>(constant_texture(tilted),
+            std::make_shared<RoughPlasticBSDF>(MicrofacetType::GGX, 0.3f, 1.5f, 1.f, constant_texture(0.5f)));
+    }, {20.f, 70.f});
+    add("normalmap_roughplastic_noflip_noshadowing", [=] {
+        return std::make_shared<NormalMapBSDF>(constant_texture(tilted),
+            std::make_shared<RoughPlasticBSDF>(MicrofacetType::Beckmann, 0.2f, 1.5f, 1.f, constant_texture(0.5f)),
+            false, false);
+    }, {40.f});
     return cases;
 }
 

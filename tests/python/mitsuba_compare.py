@@ -1,6 +1,7 @@
 """Shared by the tests that render a small scene of the project's own with Mitsuba 3 and with neepp and
 compare the images: Mitsuba's render (scalar_rgb, no LLVM needed) and the agreement test (the mean within
-a relative tolerance plus 4 standard errors, and each of 3 x 3 regions within a wider one)."""
+a relative tolerance plus 4 standard errors, and each of 3 x 3 regions within a wider one), optionally
+with a per-block z-test of the pixel differences."""
 from __future__ import annotations
 
 import subprocess
@@ -42,9 +43,23 @@ def assert_agrees(img, ref, what, mean_tol: float = 0.01, region_tol: float = 0.
             assert abs(ma - mb) < 4 * s + region_tol * mb + 1e-4, (what, i, j, ma, mb, s)
 
 
-def neepp_agrees(xml, ref, integrator: str, spp: int, neepp_bin, out_dir) -> None:
-    """neepp's render of the scene file with the integrator agrees with Mitsuba's image (assert_agrees)."""
+def assert_blocks_agree(img, ref, what, block: int = 12, level: float = 0.01):
+    """Every block x block tile passes a z-test of its pixel differences (Sidak-corrected, all tiles together
+    failing with probability `level` when the images agree). assert_agrees's standard errors come from the
+    spread of the difference over tiles, which a structural difference inflates as well (a normal map read
+    mirrored can pass it); here each tile's variance comes from its own pixels, and a structural difference
+    shows as a shifted tile mean."""
+    frac, z_crit, n = metrics.block_agreement(img[..., :3], ref[..., :3], block, level)
+    z = metrics.block_z_scores(img[..., :3], ref[..., :3], block)
+    assert frac == 1.0, (what, f"{n - round(frac * n)} of {n} blocks beyond |z| {z_crit:.2f}", z.round(1).tolist())
+
+
+def neepp_agrees(xml, ref, integrator: str, spp: int, neepp_bin, out_dir, blocks: bool = False) -> None:
+    """neepp's render of the scene file with the integrator agrees with Mitsuba's image (assert_agrees, and
+    assert_blocks_agree when blocks)."""
     r = runner.run_neepp(xml, out_dir / f"neepp_{xml.stem}_{integrator}.exr", spp=spp, seed=3, binary=neepp_bin,
                          integrator=integrator)
     assert (r.image == r.image).all(), "NaN in the image"
     assert_agrees(r.image, ref, (xml.stem, integrator))
+    if blocks:
+        assert_blocks_agree(r.image, ref, (xml.stem, integrator))

@@ -5,6 +5,7 @@
 
 #include "neepp/materials/diffuse.h"
 #include "neepp/materials/roughconductor.h"
+#include "neepp/materials/bumpmap.h"
 #include "neepp/materials/twosided.h"
 #include "neepp/sampling/rng.h"
 #include "neepp/scene/shape.h"

@@ -2,10 +2,13 @@
 #include <optional>
 #include "neepp/loader/supported_plugins.h"
 #include "neepp/loader/factories.h"
+#include "neepp/materials/blendbsdf.h"
+#include "neepp/materials/bumpmap.h"
 #include "neepp/materials/conductor.h"
 #include "neepp/materials/dielectric.h"
 #include "neepp/materials/diffuse.h"
 #include "neepp/materials/ior.h"
+#include "neepp/materials/normalmap.h"
 #include "neepp/materials/plastic.h"
 #include "neepp/materials/principled.h"
 #include "neepp/materials/principledthin.h"
@@ -174,6 +177,17 @@ BSDFPtr Factories::create_bsdf(const XmlNode &node) {
         b = std::make_shared<BumpMapBSDF>(texture(*tex[0]), node.get_float("scale", 1.f), bsdf(*kids[0]),
                                           node.get_bool("flip_invalid_normals", true),
                                           node.get_bool("use_shadowing_function", true));
+    } else if (t == "normalmap") {
+        auto kids = nested(1, 1);
+        TexturePtr normals = texture_param_or_null(node, "normalmap");
+        if (!normals) throw node.error("needs a texture named 'normalmap' (the tangent-space normals)");
+        b = std::make_shared<NormalMapBSDF>(normals, bsdf(*kids[0]), node.get_bool("flip_invalid_normals", true),
+                                            node.get_bool("use_shadowing_function", true));
+    } else if (t == "blendbsdf") {
+        auto kids = nested(2, 2);
+        TexturePtr weight = texture_param_or_null(node, "weight");
+        if (!weight) throw node.error("needs a 'weight' (a float or a texture: 0 gives the first BSDF, 1 the second)");
+        b = std::make_shared<BlendBSDF>(weight, bsdf(*kids[0]), bsdf(*kids[1]));
     } else if (t == "conductor") {
         auto [eta, k] = conductor_ior(*this, node);
         b = std::make_shared<ConductorBSDF>(eta, k, texture_param_or_null(node, "specular_reflectance"));

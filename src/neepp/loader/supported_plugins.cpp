@@ -8,7 +8,8 @@ const std::vector<std::pair<std::string, std::vector<std::string>>> &supported_p
     static const std::vector<std::pair<std::string, std::vector<std::string>>> plugins = {
         {"shape", {"obj", "ply", "rectangle", "cube", "sphere", "disk", "cylinder"}},
         {"bsdf", {"diffuse", "twosided", "mask", "bumpmap", "conductor", "roughconductor", "plastic", "roughplastic",
-                  "dielectric", "roughdielectric", "thindielectric", "principled", "principledthin", "null"}},
+                  "dielectric", "roughdielectric", "thindielectric", "principled", "principledthin", "null", "normalmap",
+                  "blendbsdf"}},
         {"texture", {"bitmap", "checkerboard"}},
         {"emitter", {"area", "envmap", "constant", "point", "spot", "directional"}},
         {"sensor", {"perspective"}},

@@ -1,0 +1,33 @@
+// Mitsuba's `blendbsdf`: (1 - w) times the first nested BSDF plus w times the second, w a float or a
+// texture clamped to [0, 1]. Sampling picks the second with probability w and the first otherwise; a
+// direction from a smooth lobe then gets the blend's own density, the two pdfs weighted alike, so that its
+// weight is the blended eval over it.
+#pragma once
+#include "neepp/materials/bsdf.h"
+
+namespace neepp {
+
+class BlendBSDF final : public BSDF {
+public:
+    BlendBSDF(TexturePtr weight, BSDFPtr first, BSDFPtr second)
+        : weight_(std::move(weight)), first_(std::move(first)), second_(std::move(second)) {}
+    Color eval(const BSDFContext &ctx, const SurfaceInteraction &si, const Vec3 &wi, const Vec3 &wo) const override;
+    float pdf(const BSDFContext &ctx, const SurfaceInteraction &si, const Vec3 &wi, const Vec3 &wo) const override;
+    BSDFEval eval_pdf(const BSDFContext &ctx, const SurfaceInteraction &si, const Vec3 &wi, const Vec3 &wo) const override;
+    BSDFSample sample(const BSDFContext &ctx, const SurfaceInteraction &si, const Vec3 &wi, float u1,
+                      Vec2 u2) const override;
+    uint32_t flags() const override { return first_->flags() | second_->flags(); }
+    void prefetch(const SurfaceInteraction &si) const override {
+        weight_->prefetch(si);
+        first_->prefetch(si);
+        second_->prefetch(si);
+    }
+    bool needs_tangents() const override { return first_->needs_tangents() || second_->needs_tangents(); }
+
+private:
+    float weight(const SurfaceInteraction &si) const;
+    TexturePtr weight_;
+    BSDFPtr first_, second_;
+};
+
+}  // namespace neepp
