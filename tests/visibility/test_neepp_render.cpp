@@ -6,6 +6,7 @@
 #include "neepp/integrators/path.h"
 #include "neepp/sampling/sampler.h"
 #include "neepp/scene/scene.h"
+#include "neepp/visibility/map_seeding.h"
 #include "neepp/visibility/neepp_shadow_rays.h"
 #include "test_scenes.h"
 #include "visibility_test_scenes.h"
@@ -335,4 +336,48 @@ TEST(NeeppRender, MergedStatesAddWhatEachRenderLearned) {
     }
     EXPECT_EQ(base.merge_states(base_state, {}), base_state);
     EXPECT_EQ(base.merge_states(base_state, {first}), first);
+}
+
+namespace {
+
+// The two rooms standing on a ground plane 400 units across that the camera, inside, never sees.
+std::string two_rooms_on_ground_path() {
+    std::string xml = two_rooms_xml();
+    xml.insert(xml.rfind("</scene>"), R"(  <shape type="rectangle"><transform name="to_world"><scale value="200"/><rotate x="1" angle="-90"/><translate y="-0.01"/></transform><ref id="white"/></shape>
+)");
+    return write_temp_scene(xml, "rooms_on_ground.xml");
+}
+
+}  // namespace
+
+TEST(NeeppRender, ShadingBoundsSpendTheGridWhereTheCameraShades) {
+    const std::string path = two_rooms_on_ground_path();
+    auto scene = load_scene(path);
+    const BBox all = scene->bounds(), shading = shading_bounds(*scene, SeedingOptions{});
+    EXPECT_GT(all.extent().x, 300.f);
+    // The rooms span x in [-2, 2], y in [0, 2], z in [-1, 1]: the bounds lie within them (the camera's
+    // paths need not reach every corner), and cover most of them.
+    const Vec3 rooms_lo(-2.01f, -0.02f, -1.01f), rooms_hi(2.01f, 2.01f, 1.01f);
+    for (int k = 0; k < 3; ++k) {
+        EXPECT_GE(shading.lo[k], rooms_lo[k]) << k;
+        EXPECT_LE(shading.hi[k], rooms_hi[k]) << k;
+        EXPECT_GT(shading.extent()[k], 0.7f * (rooms_hi[k] - rooms_lo[k])) << k;
+    }
+    // Renders over that grid agree with plain NEE.
+    const OptionMap fitted{{"shadow_rays", "neepp"}, {"grid_bounds", "shading"}};
+    std::vector<std::vector<double>> ref, test;
+    for (int s = 0; s < 6; ++s) {
+        ref.push_back(block_means(render_scene_file(path, 32, 11 + 7919 * s, Options()).image, 6, 6));
+        test.push_back(block_means(render_scene_file(path, 32, 23 + 7919 * s, Options(fitted)).image, 6, 6));
+    }
+    for (const std::string bounds : {"scene", "shading"}) {
+        NeeppOptions o;
+        o.grid_bounds = bounds;
+        NeeppShadowRays tester(o);
+        tester.prepare(*scene);
+        const int occupied = tester.statistics()["map"]["occupied_voxels"].get<int>();
+        if (bounds == "scene") EXPECT_LE(occupied, 32) << "the rooms fit in a column or two of the scene's grid";
+        else EXPECT_GT(occupied, 200) << "the rooms cover much of a fitted 16^3 grid";
+    }
+    expect_same_image(moments_over_seeds(ref), moments_over_seeds(test), "grid_bounds=shading");
 }

@@ -21,6 +21,7 @@ std::unique_ptr<ShadowRayTester> make_shadow_ray_tester(const Options &options, 
     n.policy = parse_shadow_ray_policy(policy);
     n.voxels = voxels;
     n.samples_per_pair = options.get_int("samples_per_pair", n.samples_per_pair);
+    n.grid_bounds = options.get_string("grid_bounds", n.grid_bounds);
     n.q_min = options.get_float("q_min", n.q_min);
     n.map_file = options.get_string("visibility_map", n.map_file);
     n.learn = options.get_bool("learn", n.learn);

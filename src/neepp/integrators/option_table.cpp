@@ -23,6 +23,7 @@ std::vector<OptionDoc> shadow_ray_options() {
         {"shadow_rays", "nee", "how shadow rays (and BDPT's connections) are traced: nee, neepp, neepp-adaptive, neepp-cv", ""},
         {"voxels", text(n.voxels), "NEE++ grid resolution N (N^3 voxels)", any},
         {"samples_per_pair", text(n.samples_per_pair), "explicit shadow rays per voxel pair when seeding the map", any},
+        {"grid_bounds", n.grid_bounds, "what the grid covers: scene (its bounds) or shading (where camera paths shade)", any},
         {"q_min", text(n.q_min), "the least probability with which a shadow ray is traced", any},
         {"visibility_map", "", "map file: loaded if it exists and belongs to this scene, else built and saved", any},
         {"learn", text(n.learn), "update the map from the shadow rays the render traces", any},

@@ -1,5 +1,7 @@
 #include "neepp/visibility/map_seeding.h"
 
+#include <algorithm>
+#include <array>
 #include <chrono>
 #include <stdexcept>
 #include <tbb/parallel_for.h>
@@ -38,22 +40,18 @@ Ray ray_between(const Vec3 &x, const Vec3 &nx, const Vec3 &target, bool infinite
     return infinite ? spawn_ray(x, nx, target) : spawn_ray_to(x, nx, target);
 }
 
-}  // namespace
+// 1. Camera pre-pass: each path writes its points into its own slots, so the result is independent of
+//    scheduling; B slots per path, path_len[i] of them filled.
+struct Prepass {
+    int bounces = 1;
+    std::vector<CellPoint> points;
+    std::vector<uint8_t> len;
+};
 
-SeedingStats seed_visibility_map(const Scene &scene, const VoxelGrid &grid, VisibilityMap &map,
-                                 const SeedingOptions &opt) {
-    if (map.cell_count() != grid.cell_count()) throw std::invalid_argument("seed_visibility_map: map/grid mismatch");
-    if (opt.samples_per_pair < 1) throw std::invalid_argument("samples_per_pair must be >= 1");
-    auto t0 = std::chrono::steady_clock::now();
-    SeedingStats stats;
-    const uint32_t cells = grid.cell_count();
-
-    // 1. Camera pre-pass: each path writes its points into its own slots, so the result is independent
-    //    of scheduling; they are then inserted into the reservoirs in path order.
+Prepass camera_prepass(const Scene &scene, const SeedingOptions &opt) {
     const int G = std::max(1, opt.camera_grid), B = std::max(1, opt.bounces);
     const size_t paths = size_t(G) * G;
-    std::vector<CellPoint> path_points(paths * B);
-    std::vector<uint8_t> path_len(paths, 0);
+    Prepass pre{B, std::vector<CellPoint>(paths * B), std::vector<uint8_t>(paths, 0)};
     tbb::parallel_for(tbb::blocked_range<size_t>(0, paths, 256), [&](const tbb::blocked_range<size_t> &r) {
         const DenormalsAreZero ftz;
         for (size_t i = r.begin(); i != r.end(); ++i) {
@@ -64,13 +62,52 @@ SeedingStats seed_visibility_map(const Scene &scene, const VoxelGrid &grid, Visi
                 SurfaceInteraction si;
                 if (!scene.intersect(ray, si)) break;
                 Vec3 n = dot(si.n, ray.d) > 0 ? -si.n : si.n;  // the side the path arrived from
-                path_points[i * B + b] = {si.p, n};
-                path_len[i] = uint8_t(b + 1);
+                pre.points[i * B + b] = {si.p, n};
+                pre.len[i] = uint8_t(b + 1);
                 Vec3 d = Frame(n).to_world(square_to_cosine_hemisphere(rng.next_2d()));
                 ray = spawn_ray(si.p, n, d);
             }
         }
     });
+    return pre;
+}
+
+}  // namespace
+
+BBox shading_bounds(const Scene &scene, const SeedingOptions &opt) {
+    const Prepass pre = camera_prepass(scene, opt);
+    std::array<std::vector<float>, 3> axis;
+    for (size_t i = 0; i < pre.len.size(); ++i)
+        for (int b = 0; b < pre.len[i]; ++b)
+            for (int k = 0; k < 3; ++k) axis[k].push_back(pre.points[i * pre.bounces + b].p[k]);
+    const BBox all = scene.bounds();
+    if (axis[0].size() < 100) return all;  // too few points to say where rendering happens
+    BBox b;
+    for (int k = 0; k < 3; ++k) {
+        auto &v = axis[k];
+        const size_t lo = v.size() / 100, hi = v.size() - 1 - v.size() / 100;
+        std::nth_element(v.begin(), v.begin() + lo, v.end());
+        b.lo[k] = std::max(v[lo], all.lo[k]);
+        std::nth_element(v.begin(), v.begin() + hi, v.end());
+        b.hi[k] = std::min(v[hi], all.hi[k]);
+        if (!(b.hi[k] > b.lo[k])) b.lo[k] = all.lo[k], b.hi[k] = all.hi[k];  // a flat spread: the scene's extent
+    }
+    return b;
+}
+
+SeedingStats seed_visibility_map(const Scene &scene, const VoxelGrid &grid, VisibilityMap &map,
+                                 const SeedingOptions &opt) {
+    if (map.cell_count() != grid.cell_count()) throw std::invalid_argument("seed_visibility_map: map/grid mismatch");
+    if (opt.samples_per_pair < 1) throw std::invalid_argument("samples_per_pair must be >= 1");
+    auto t0 = std::chrono::steady_clock::now();
+    SeedingStats stats;
+    const uint32_t cells = grid.cell_count();
+
+    const Prepass pre = camera_prepass(scene, opt);
+    const size_t paths = pre.len.size();
+    const int B = pre.bounces;
+    const std::vector<CellPoint> &path_points = pre.points;
+    const std::vector<uint8_t> &path_len = pre.len;
     for (size_t i = 0; i < paths; ++i) stats.camera_rays += std::min<uint64_t>(uint64_t(path_len[i]) + 1, uint64_t(B));
     Reservoirs surface(cells, opt.points_per_voxel, opt.seed + 1);
     std::vector<CellPoint> all_points;

@@ -37,6 +37,12 @@ struct SeedingStats {
     uint64_t seeded_pairs = 0;     // pairs that received at least one sample
 };
 
+// Where rendering shades: the bounds of the pre-pass's surface points (step 1), each axis cut at its 1st
+// and 99th percentile so that a few far points (a ground plane seen through a window) do not set them,
+// within the scene's bounds. A grid over them spends its voxels where the shading points are; points
+// outside fall in its boundary voxels.
+BBox shading_bounds(const Scene &scene, const SeedingOptions &options);
+
 // Adds the explicit samples to map (which must have grid.cell_count() cells).
 SeedingStats seed_visibility_map(const Scene &scene, const VoxelGrid &grid, VisibilityMap &map, const SeedingOptions &options);
 

@@ -35,6 +35,8 @@ NeeppShadowRays::NeeppShadowRays(NeeppOptions options)
       ray_budget_(options_.policy == ShadowRayPolicy::NeeppAdaptive && options_.adaptive_target == "rays") {
     if (!(options_.q_min > 0.f && options_.q_min <= 1.f))
         throw std::invalid_argument("q_min must be in (0, 1]: q = 0 where visibility can be 1 would bias the image");
+    if (options_.grid_bounds != "scene" && options_.grid_bounds != "shading")
+        throw std::invalid_argument("grid_bounds must be 'scene' or 'shading'");
     if (options_.samples_per_pair < 1 || options_.samples_per_pair > 4096)
         throw std::invalid_argument("samples_per_pair must be in [1, 4096]");
     if (options_.voxels < 1 || options_.voxels > VoxelGrid::kMaxResolution)
@@ -156,7 +158,8 @@ void NeeppShadowRays::prepare(const Scene &scene) {
     if (adopted_) return;
     seeding_ = SeedingStats{};
     load_time_s_ = 0;
-    grid_ = VoxelGrid(scene.bounds(), options_.voxels);
+    grid_ = VoxelGrid(options_.grid_bounds == "shading" ? shading_bounds(scene, SeedingOptions{}) : scene.bounds(),
+                      options_.voxels);
     const uint64_t fingerprint = scene_fingerprint(scene);
     if (!options_.map_file.empty() && std::filesystem::exists(options_.map_file)) {
         // A file that exists but is damaged or belongs to another scene or grid is refused (throws), not
@@ -349,6 +352,7 @@ nlohmann::json NeeppShadowRays::describe() const {
     nlohmann::json j = {{"policy", policy()},
                         {"voxels", options_.voxels},
                         {"samples_per_pair", options_.samples_per_pair},
+                        {"grid_bounds", options_.grid_bounds},
                         {"q_min", options_.q_min},
                         {"learn", options_.learn},
                         {"learn_until", options_.learn_until},

@@ -49,6 +49,9 @@ struct NeeppOptions {
     ShadowRayPolicy policy = ShadowRayPolicy::Neepp;
     int voxels = 16;             // grid resolution N (the paper: higher is no better)
     int samples_per_pair = 16;   // explicit samples per pair when seeding (the paper: 16 suffice)
+    // What the grid covers: "scene" (the scene's bounds) or "shading" (shading_bounds: where the camera's
+    // paths shade, which differs where a scene holds large geometry far from what the camera sees).
+    std::string grid_bounds = "scene";
     // Lower bound of q. It bounds the weight 1/q and so the variance blow-up where the map is wrong
     // (a pair estimated occluded that is in fact visible costs at most a factor 1/q_min in variance). 0.05
     // is the low end of the range NEEPP.md names: with the default 16 seeding samples, a pair seen fully
