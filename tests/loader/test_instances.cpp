@@ -83,6 +83,7 @@ TEST(Instances, PutTheGroupsShapesWhereHandPlacedOnesWouldBe) {
         if (a.kind == Shape::Kind::Sphere) {
             EXPECT_LT(norm(a.center - b.center), 1e-5f) << i;
             EXPECT_NEAR(a.radius, b.radius, 1e-5f) << i;
+            for (int k = 0; k < 3; ++k) EXPECT_LT(norm(a.sphere_axes[k] - b.sphere_axes[k]), 1e-5f) << i << " " << k;
             continue;
         }
         ASSERT_EQ(a.positions.size(), b.positions.size());

@@ -1,12 +1,13 @@
 """Mitsuba 3's `serialized` meshes and `shapegroup`/`instance`: a scene of the project's own rendered by
 neepp and by Mitsuba 3 agrees (the mean within 1 % plus 4 standard errors, each of 3 x 3 regions within 2 %,
 and each 6 x 6 pixel tile within 5 %: the group's pyramid swapped for the torus by a wrong shape_index, an
-instance's scale or the pyramid's face_normals left out each fail that).
+instance's scale or the pyramid's face_normals left out, or a sphere's uv that ignores its rotation, each
+fail that).
 The .serialized file is written here in Mitsuba's layout (version 4, the pip Mitsuba has no writer): two
 meshes, a textured torus with normals and uvs in single precision, and a pyramid without normals in double
 precision with vertex colours, so that the offset table, both precisions and the skipped colours show.
-The pyramid (faceted) and a sphere form a group instanced twice, turned and scaled, beside the torus
-placed directly."""
+The pyramid (faceted) and a sphere turned on its side, whose texture shows its axes, form a group instanced
+twice, turned and scaled, beside the torus placed directly."""
 from __future__ import annotations
 
 import math
@@ -82,8 +83,10 @@ SCENE = """<scene version="3.0.0">
     <shape type="serialized"><string name="filename" value="meshes.serialized"/><integer name="shape_index" value="1"/>
       <boolean name="face_normals" value="true"/>
       <bsdf type="roughplastic"><float name="alpha" value="0.2"/><rgb name="diffuse_reflectance" value="0.2,0.6,0.3"/></bsdf></shape>
-    <shape type="sphere"><point name="center" x="0.6" y="0.2" z="0"/><float name="radius" value="0.2"/>
-      <bsdf type="diffuse"><rgb name="reflectance" value="0.8,0.3,0.3"/></bsdf></shape>
+    <shape type="sphere"><float name="radius" value="0.3"/>
+      <transform name="to_world"><rotate x="1" angle="90"/><translate x="0.7" y="0.3"/></transform>
+      <bsdf type="diffuse"><texture name="reflectance" type="checkerboard"><rgb name="color0" value="0.9,0.2,0.2"/>
+        <rgb name="color1" value="0.9,0.9,0.8"/><transform name="to_uv"><scale x="2"/></transform></texture></bsdf></shape>
   </shape>
   <shape type="instance"><ref id="group"/>
     <transform name="to_world"><rotate y="1" angle="25"/><translate x="-0.9" z="-0.4"/></transform></shape>

@@ -141,15 +141,24 @@ void compute_vertex_normals(Shape &s) {
 
 // Moves the shape's mesh or sphere by `to_world`: a mesh's vertex normals keep their direction
 // relative to the surface (the inverse transpose, renormalized). A to_world on a sphere may translate,
-// rotate and scale uniformly (Mitsuba allows more; neepp refuses).
+// rotate, mirror and scale uniformly, its axes turning with it (Mitsuba allows more; neepp refuses).
 void transform_shape(Shape &s, const Transform &to_world) {
     if (s.kind == Shape::Kind::Sphere) {
-        const Vec3 ex = to_world.vector(Vec3(s.radius, 0, 0)), ey = to_world.vector(Vec3(0, s.radius, 0));
+        Vec3 axes[3];
+        float scale[3];
+        for (int i = 0; i < 3; ++i) {
+            axes[i] = to_world.vector(s.sphere_axes[i]);
+            scale[i] = norm(axes[i]);
+        }
+        const float tol = 1e-4f * scale[0] * scale[0];
+        if (std::abs(scale[1] - scale[0]) > 1e-4f * scale[0] || std::abs(scale[2] - scale[0]) > 1e-4f * scale[0] ||
+            std::abs(dot(axes[0], axes[1])) > tol || std::abs(dot(axes[0], axes[2])) > tol || std::abs(dot(axes[1], axes[2])) > tol)
+            throw std::runtime_error("sphere to_world must scale uniformly (and not shear)");
         s.center = to_world.point(s.center);
-        s.radius = norm(ex);
-        if (std::abs(norm(ey) - s.radius) > 1e-4f * s.radius) throw std::runtime_error("sphere to_world must scale uniformly");
+        s.radius *= scale[0];
         if (!(s.radius > 0) || !std::isfinite(s.radius) || !is_finite(s.center))
             throw std::runtime_error("sphere needs a positive radius and a finite center");
+        for (int i = 0; i < 3; ++i) s.sphere_axes[i] = axes[i] / scale[i];
         return;
     }
     for (Vec3 &p : s.positions) {
