@@ -1,11 +1,12 @@
 // The scene loader on arbitrary XML: parsing (pugixml, then Mitsuba's elements: defaults, -D
 // substitution, includes, refs, transforms), every plugin's parameters, and building the scene (meshes,
-// textures, lights, the BVH). The input is written beside a small OBJ, PLY and PNG, so that files it
+// textures, lights, the BVH). The input is written beside a small OBJ, PLY, .serialized and PNG, so that files it
 // names can be found. The first line, when it starts with "-D ", holds name=value parameter overrides
 // (as the CLI's -D), to fuzz their substitution too.
 #include <exception>
 #include <map>
 #include <sstream>
+#include "common/serialized_writer.h"
 #include "fuzz_input.h"
 #include "neepp/io/image.h"
 #include "neepp/loader/scene_loader.h"
@@ -19,6 +20,11 @@ void write_companions() {
         "element face 1\nproperty list uchar int vertex_indices\nend_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n";
     neepp::fuzz::write_input(reinterpret_cast<const uint8_t *>(kObj), sizeof(kObj) - 1, "mesh.obj");
     neepp::fuzz::write_input(reinterpret_cast<const uint8_t *>(kPly), sizeof(kPly) - 1, "mesh.ply");
+    neepp::testing::SerializedTestMesh tri;
+    tri.positions = {0, 0, 0, 1, 0, 0, 0, 1, 0};
+    tri.indices = {0, 1, 2};
+    const std::string serialized = neepp::testing::serialized({tri, tri});
+    neepp::fuzz::write_input(reinterpret_cast<const uint8_t *>(serialized.data()), serialized.size(), "mesh.serialized");
     neepp::write_png_srgb((neepp::fuzz::scratch_dir() / "texture.png").string(), neepp::Image(2, 2, 3));
 }
 
@@ -40,6 +46,15 @@ extern "C" int LLVMFuzzerInitialize(int *, char ***) {
             "<emitter type='area'><rgb name='radiance' value='$albedo'/></emitter></shape>"
             "<shape type='sphere'><bsdf type='twosided'><bsdf type='roughplastic'/></bsdf></shape>"
             "<emitter type='point'><point name='position' x='0' y='1' z='0'/></emitter></scene>\n");
+        neepp::fuzz::write_seed(
+            dir, "instances.xml",
+            "<scene version='3.0.0'><sensor type='perspective'><film type='hdrfilm'><integer name='width' value='8'/>"
+            "<integer name='height' value='8'/></film></sensor>"
+            "<shape type='shapegroup' id='group'><shape type='serialized'><string name='filename' value='mesh.serialized'/>"
+            "<integer name='shape_index' value='1'/><bsdf type='diffuse'/></shape><shape type='sphere'/></shape>"
+            "<shape type='instance'><ref id='group'/></shape>"
+            "<shape type='instance'><ref id='group'/><transform name='to_world'><translate x='2'/></transform></shape>"
+            "<emitter type='constant'/></scene>\n");
     });
     write_companions();
     return 0;

@@ -11,7 +11,7 @@ ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 SECONDS_EACH="${1:-30}"
 shift || true
 TARGETS=("$@")
-[ ${#TARGETS[@]} -eq 0 ] && TARGETS=(scene obj ply image map_file integrator_options)
+[ ${#TARGETS[@]} -eq 0 ] && TARGETS=(scene obj ply serialized image map_file integrator_options)
 SHARED="$ROOT/../shared/scenes"
 B="$ROOT/build-sanitize"
 W="$B/fuzz"

@@ -5,7 +5,7 @@
 set -euo pipefail
 
 PKGS=(cmake ninja-build g++ pkg-config libembree-dev libtbb-dev libopenexr-dev libimath-dev libpugixml-dev
-      libjpeg-dev libcli11-dev libfmt-dev libstb-dev nlohmann-json3-dev libgtest-dev
+      libjpeg-dev zlib1g-dev libcli11-dev libfmt-dev libstb-dev nlohmann-json3-dev libgtest-dev
       python3-venv "$@")
 
 missing=()

@@ -6,6 +6,8 @@ from __future__ import annotations
 
 import subprocess
 
+import numpy as np
+
 from neepp_tools import exr, metrics, runner
 
 # The camera and film both test scenes use: 48 x 36 pixels, box filter, the sample count as $spp.
@@ -54,12 +56,26 @@ def assert_blocks_agree(img, ref, what, block: int = 12, level: float = 0.01):
     assert frac == 1.0, (what, f"{n - round(frac * n)} of {n} blocks beyond |z| {z_crit:.2f}", z.round(1).tolist())
 
 
-def neepp_agrees(xml, ref, integrator: str, spp: int, neepp_bin, out_dir, blocks: bool = False) -> None:
+def assert_tiles_within(img, ref, what, block: int = 6, rel_tol: float = 0.05, abs_tol: float = 0.005):
+    """Each block x block tile's mean within rel_tol of the reference's plus abs_tol. assert_agrees takes
+    its error bars from the difference image, so a difference in shape inside a region (an object moved or
+    swapped) widens its own tolerance; a fixed one per tile does not, and catches it."""
+    def tiles(x):
+        x = x[..., :3].mean(axis=-1)
+        h, w = (x.shape[0] // block) * block, (x.shape[1] // block) * block
+        return x[:h, :w].reshape(h // block, block, w // block, block).mean(axis=(1, 3))
+    a, b = tiles(img), tiles(ref)
+    bad = np.argwhere(np.abs(a - b) > rel_tol * b + abs_tol)
+    assert len(bad) == 0, (what, [(int(i), int(j), float(a[i, j]), float(b[i, j])) for i, j in bad[:5]])
+
+
+def neepp_agrees(xml, ref, integrator: str, spp: int, neepp_bin, out_dir, blocks: bool = False):
     """neepp's render of the scene file with the integrator agrees with Mitsuba's image (assert_agrees, and
-    assert_blocks_agree when blocks)."""
+    assert_blocks_agree when blocks); returns it."""
     r = runner.run_neepp(xml, out_dir / f"neepp_{xml.stem}_{integrator}.exr", spp=spp, seed=3, binary=neepp_bin,
                          integrator=integrator)
     assert (r.image == r.image).all(), "NaN in the image"
     assert_agrees(r.image, ref, (xml.stem, integrator))
     if blocks:
         assert_blocks_agree(r.image, ref, (xml.stem, integrator))
+    return r.image

@@ -115,4 +115,31 @@ TEST(ShadingFrame, SphereFrameFollowsDpDuWhenTangentsAreRead) {
     }
 }
 
+// A turned sphere's uv and dp/du follow its own axes: at the world point along its local direction
+// (sin θ cos φ, sin θ sin φ, cos θ), uv is (φ / 2π, θ / π) whatever the turn, as in Mitsuba.
+TEST(ShadingFrame, TurnedSphereUvFollowsItsAxes) {
+    Shape s;
+    s.kind = Shape::Kind::Sphere;
+    s.center = Vec3(1.f, 2.f, 3.f);
+    s.radius = 0.5f;
+    // Local x, y, z along world y, z, x: a proper rotation.
+    s.sphere_axes[0] = Vec3(0, 1, 0), s.sphere_axes[1] = Vec3(0, 0, 1), s.sphere_axes[2] = Vec3(1, 0, 0);
+    s.bsdf = std::make_shared<RoughConductorBSDF>(MicrofacetType::GGX, constant_texture(0.2f), constant_texture(0.2f),
+                                                  constant_texture(Color(0.2f)), constant_texture(Color(3.f)));
+    s.finalize();
+    for (const auto &[theta, phi] : std::vector<std::pair<float, float>>{{0.7f, 0.3f}, {2.1f, 4.0f}, {1.2f, 5.9f}}) {
+        const Vec3 local(std::sin(theta) * std::cos(phi), std::sin(theta) * std::sin(phi), std::cos(theta));
+        const Vec3 dir = s.sphere_axes[0] * local.x + s.sphere_axes[1] * local.y + s.sphere_axes[2] * local.z;
+        const Ray ray{s.center + dir * 3.f, -dir, 0.f, kInfinity};
+        SurfaceInteraction si;
+        s.fill_interaction(0, 0.f, 0.f, ray, 2.5f, si);
+        EXPECT_NEAR(si.uv.x, phi / (2 * kPi), 1e-5f);
+        EXPECT_NEAR(si.uv.y, theta / kPi, 1e-5f);
+        const Vec3 dpdu_local(-local.y, local.x, 0.f);
+        const Vec3 dpdu = (s.sphere_axes[0] * dpdu_local.x + s.sphere_axes[1] * dpdu_local.y) * (2 * kPi * s.radius);
+        EXPECT_LT(norm(si.dpdu - dpdu), 1e-4f);
+        EXPECT_NEAR(norm(si.sh_frame.s - normalize(dpdu)), 0.f, 1e-4f);
+    }
+}
+
 }  // namespace

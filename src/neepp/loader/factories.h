@@ -20,17 +20,25 @@ public:
     BSDFPtr bsdf(const XmlNode &node);
     BSDFPtr default_bsdf();
     BSDFPtr black_bsdf();  // an emitter's default
-    // Creates the shape (and its area light, if any) and adds both to the scene.
+    // Creates the shape (and its area light, if any) and adds both to the scene. A `shapegroup` adds
+    // nothing (its shapes are built for the instances); an `instance` adds placed copies of its group's.
     void shape(const XmlNode &node, Scene &scene);
     void emitter(const XmlNode &node, Scene &scene);
 
 private:
+    // The shape in world space with its BSDF; emitter_node is set to its <emitter>, null when none.
+    std::unique_ptr<Shape> build_shape(const XmlNode &node, const XmlNode *&emitter_node);
+    // A shapegroup's shapes (each in its own to_world), built at the first use and shared by every
+    // instance of the group (loader/instances.cpp).
+    const std::vector<Shape> &shape_group(const XmlNode &node);
+    void instance(const XmlNode &node, Scene &scene);
     BSDFPtr create_bsdf(const XmlNode &node);
     TexturePtr principled_lobe_param(const XmlNode &node, const std::string &name);
     PrincipledParams principled_params(const XmlNode &node);
     PrincipledThinParams principled_thin_params(const XmlNode &node);
     std::map<const XmlNode *, TexturePtr> textures_;
     std::map<const XmlNode *, BSDFPtr> bsdfs_;
+    std::map<const XmlNode *, std::vector<Shape>> shape_groups_;
     BSDFPtr default_bsdf_, black_bsdf_;
 };
 
@@ -38,6 +46,9 @@ private:
 // that renders the same image (prb, volpath without media, direct, ptracer, the moment wrapper), said
 // in one line on stderr.
 void load_integrator(const XmlNode &node, RenderSettings &settings);
+// Moves a shape (a mesh or a sphere) by to_world, its normals with it; throws std::runtime_error when
+// the result is not finite, or when it would make a sphere an ellipsoid.
+void transform_shape(Shape &s, const Transform &to_world);
 // Reports properties that no builder read (misspelt or unsupported) on stderr, as Mitsuba does.
 void warn_unused(const XmlNode &node);
 // An IOR given as a number or a name from Mitsuba's table ("bk7", "air"...).

@@ -3,6 +3,7 @@
 #include "neepp/loader/supported_plugins.h"
 #include "neepp/io/obj_reader.h"
 #include "neepp/io/ply_reader.h"
+#include "neepp/io/serialized_reader.h"
 #include "neepp/lights/area_light.h"
 #include "neepp/lights/environment_light.h"
 #include "neepp/lights/directional_light.h"
@@ -136,19 +137,49 @@ void compute_vertex_normals(Shape &s) {
     }
 }
 
-void set_mesh(Shape &s, MeshData mesh, const Transform &to_world) {
-    s.positions.resize(mesh.positions.size());
-    for (size_t i = 0; i < mesh.positions.size(); ++i) s.positions[i] = to_world.point(mesh.positions[i]);
-    s.normals.resize(mesh.normals.size());
-    for (size_t i = 0; i < mesh.normals.size(); ++i) {
-        Vec3 n = to_world.normal(mesh.normals[i]);
-        float len = norm(n);
-        s.normals[i] = len > 0 ? n / len : n;
+}  // namespace
+
+// Moves the shape's mesh or sphere by `to_world`: a mesh's vertex normals keep their direction
+// relative to the surface (the inverse transpose, renormalized). A to_world on a sphere may translate,
+// rotate, mirror and scale uniformly, its axes turning with it (Mitsuba allows more; neepp refuses).
+void transform_shape(Shape &s, const Transform &to_world) {
+    if (s.kind == Shape::Kind::Sphere) {
+        Vec3 axes[3];
+        float scale[3];
+        for (int i = 0; i < 3; ++i) {
+            axes[i] = to_world.vector(s.sphere_axes[i]);
+            scale[i] = norm(axes[i]);
+        }
+        const float tol = 1e-4f * scale[0] * scale[0];
+        if (std::abs(scale[1] - scale[0]) > 1e-4f * scale[0] || std::abs(scale[2] - scale[0]) > 1e-4f * scale[0] ||
+            std::abs(dot(axes[0], axes[1])) > tol || std::abs(dot(axes[0], axes[2])) > tol || std::abs(dot(axes[1], axes[2])) > tol)
+            throw std::runtime_error("sphere to_world must scale uniformly (and not shear)");
+        s.center = to_world.point(s.center);
+        s.radius *= scale[0];
+        if (!(s.radius > 0) || !std::isfinite(s.radius) || !is_finite(s.center))
+            throw std::runtime_error("sphere needs a positive radius and a finite center");
+        for (int i = 0; i < 3; ++i) s.sphere_axes[i] = axes[i] / scale[i];
+        return;
     }
+    for (Vec3 &p : s.positions) {
+        p = to_world.point(p);
+        if (!is_finite(p)) throw std::runtime_error("the transformed mesh has non-finite vertices");
+    }
+    for (Vec3 &n : s.normals) {
+        n = to_world.normal(n);
+        const float len = norm(n);
+        if (len > 0) n = n / len;
+    }
+}
+
+namespace {
+
+void set_mesh(Shape &s, MeshData mesh, const Transform &to_world) {
+    s.positions = std::move(mesh.positions);
+    s.normals = std::move(mesh.normals);
     s.uvs = std::move(mesh.uvs);
     s.indices = std::move(mesh.indices);
-    for (const Vec3 &p : s.positions)
-        if (!is_finite(p)) throw std::runtime_error("the transformed mesh has non-finite vertices");
+    transform_shape(s, to_world);
     if (!s.face_normals && s.normals.empty()) compute_vertex_normals(s);
 }
 
@@ -167,6 +198,32 @@ bool has_surface(const Shape &s) {
 }  // namespace
 
 void Factories::shape(const XmlNode &node, Scene &scene) {
+    if (node.type == "shapegroup") {  // built now so that its problems are found even with no instance
+        shape_group(node);
+        return;
+    }
+    if (node.type == "instance") {
+        instance(node, scene);
+        return;
+    }
+    const XmlNode *emitter_node = nullptr;
+    std::unique_ptr<Shape> s = build_shape(node, emitter_node);
+    Shape *shape = s.get();
+    scene.add_shape(std::move(s));
+    if (emitter_node) attempt([&] {
+        if (emitter_node->type != "area") throw emitter_node->error("a shape can only carry an 'area' emitter");
+        TexturePtr radiance = texture_param(*emitter_node, "radiance", Color(1.f));
+        warn_unused(*emitter_node);
+        if (!has_surface(*shape)) {
+            warn(node.file, node.line, "the " + node.type + " shape has no surface (no triangle of non-zero area): its "
+                                       "area emitter is left out");
+            return;
+        }
+        shape->area_light = scene.add_light(std::make_unique<AreaLight>(shape, radiance));
+    });
+}
+
+std::unique_ptr<Shape> Factories::build_shape(const XmlNode &node, const XmlNode *&emitter_node) {
     auto s = std::make_unique<Shape>();
     s->id = node.id;
     s->face_normals = node.get_bool("face_normals", false);
@@ -174,11 +231,12 @@ void Factories::shape(const XmlNode &node, Scene &scene) {
     Transform to_world = node.get_transform("to_world");
     const std::string &t = node.type;
     try {
-        if (t == "obj" || t == "ply") {
+        if (t == "obj" || t == "ply" || t == "serialized") {
             std::string path = node.resolve_path(node.get_string("filename"));
+            const int shape_index = t == "serialized" ? node.get_int("shape_index", 0) : 0;
             MeshData mesh;
             try {
-                mesh = t == "obj" ? read_obj(path) : read_ply(path);
+                mesh = t == "obj" ? read_obj(path) : t == "ply" ? read_ply(path) : read_serialized(path, shape_index);
             } catch (const std::exception &e) {  // the mesh's own error, located at the shape using it
                 throw node.error(e.what());
             }
@@ -193,16 +251,10 @@ void Factories::shape(const XmlNode &node, Scene &scene) {
             set_mesh(*s, cylinder_mesh(), to_world * cylinder_frame(node));
         } else if (t == "sphere") {
             s->kind = Shape::Kind::Sphere;
-            Vec3 c = node.get_vector("center", Vec3(0.f));
-            float r = node.get_float("radius", 1.f);
-            if (!(r > 0) || !std::isfinite(r)) throw node.error("sphere radius must be positive and finite");
-            // A to_world on a sphere may translate and scale uniformly (Mitsuba allows more; we refuse).
-            s->center = to_world.point(c);
-            Vec3 ex = to_world.vector(Vec3(r, 0, 0)), ey = to_world.vector(Vec3(0, r, 0));
-            s->radius = norm(ex);
-            if (std::abs(norm(ey) - s->radius) > 1e-4f * s->radius) throw node.error("sphere to_world must scale uniformly");
-            if (!(s->radius > 0) || !std::isfinite(s->radius) || !is_finite(s->center))
-                throw node.error("sphere needs a positive radius and a finite center");
+            s->center = node.get_vector("center", Vec3(0.f));
+            s->radius = node.get_float("radius", 1.f);
+            if (!(s->radius > 0) || !std::isfinite(s->radius)) throw node.error("sphere radius must be positive and finite");
+            transform_shape(*s, to_world);
         } else {
             throw node.error("unsupported shape type '" + t + "' (supported: " + supported_list("shape") + ")");
         }
@@ -212,7 +264,7 @@ void Factories::shape(const XmlNode &node, Scene &scene) {
         throw node.error(e.what());
     }
 
-    const XmlNode *emitter_node = nullptr;
+    emitter_node = nullptr;
     for (const auto &child : node.children) {
         attempt([&] {  // when checking, a broken BSDF leaves the shape the default one
             if (child->tag == "bsdf") s->bsdf = bsdf(*child);
@@ -226,19 +278,7 @@ void Factories::shape(const XmlNode &node, Scene &scene) {
     // Mitsuba's default: diffuse 0.5, black on an emitter (a light without a BSDF reflects nothing).
     if (!s->bsdf) s->bsdf = emitter_node ? black_bsdf() : default_bsdf();
     warn_unused(node);
-    Shape *shape = s.get();
-    scene.add_shape(std::move(s));
-    if (emitter_node) attempt([&] {
-        if (emitter_node->type != "area") throw emitter_node->error("a shape can only carry an 'area' emitter");
-        TexturePtr radiance = texture_param(*emitter_node, "radiance", Color(1.f));
-        warn_unused(*emitter_node);
-        if (!has_surface(*shape)) {
-            warn(node.file, node.line, "the " + node.type + " shape has no surface (no triangle of non-zero area): its "
-                                       "area emitter is left out");
-            return;
-        }
-        shape->area_light = scene.add_light(std::make_unique<AreaLight>(shape, radiance));
-    });
+    return s;
 }
 
 void Factories::emitter(const XmlNode &node, Scene &scene) {

@@ -154,14 +154,15 @@ void Shape::fill_interaction(uint32_t prim, float b1, float b2, const Ray &ray, 
     si.prim_index = prim;
     if (kind == Kind::Sphere) {
         si.p = ray.at(t);
-        Vec3 local = normalize(si.p - center);
-        si.p = center + local * radius;  // re-project for precision
-        si.n = flip_normals ? -local : local;
+        const Vec3 d = normalize(si.p - center);
+        si.p = center + d * radius;  // re-project for precision
+        si.n = flip_normals ? -d : d;
         // Mitsuba's sphere uv: (phi / 2pi, theta / pi) in the sphere's frame.
+        const Vec3 local(dot(d, sphere_axes[0]), dot(d, sphere_axes[1]), dot(d, sphere_axes[2]));
         float phi = std::atan2(local.y, local.x);
         if (phi < 0) phi += 2.f * kPi;
         si.uv = Vec2(phi * kInv2Pi, std::acos(std::clamp(local.z, -1.f, 1.f)) * kInvPi);
-        si.dpdu = Vec3(-local.y, local.x, 0) * (2.f * kPi * radius);
+        si.dpdu = (sphere_axes[1] * local.x - sphere_axes[0] * local.y) * (2.f * kPi * radius);
         si.dpdv = cross(si.n, si.dpdu);
         // Aligned with dp/du where the BSDF reads tangents, as Mitsuba; at the poles dp/du vanishes.
         const float du2 = squared_norm(si.dpdu);

@@ -33,9 +33,11 @@ struct Shape {
     bool face_normals = false;  // ignore vertex normals (Mitsuba's face_normals)
     bool flip_normals = false;
 
-    // Sphere data.
+    // Sphere data. The axes are the world directions of the sphere's own x, y and z, which its uv and
+    // dp/du follow (Mitsuba's are in the frame its to_world rotates).
     Vec3 center;
     float radius = 0;
+    Vec3 sphere_axes[3] = {{1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
 
     BSDFPtr bsdf;
     const Light *area_light = nullptr;  // set when the scene creates an area light for this shape
