@@ -73,60 +73,38 @@ std::unique_ptr<VisibilityEnvironmentSampler::GroupTable> VisibilityEnvironmentS
         total += w[g];
         mass += groups_[g].mass;
     }
-    auto table = std::make_unique<GroupTable>();
-    // Fixed point: every group with mass gets at least one unit, the rounding lands on the largest.
-    constexpr uint64_t kOne = uint64_t(1) << kFixedBits;
-    std::array<uint64_t, kGroups> units{};
-    uint64_t sum = 0;
-    uint32_t largest = 0;
-    for (uint32_t g = 0; g < kGroups; ++g) {
-        if (groups_[g].cells.empty()) continue;
-        const double p = (1.0 - options_.epsilon) * (total > 0 ? w[g] / total : groups_[g].mass / mass) +
-                         options_.epsilon * groups_[g].mass / mass;
-        units[g] = std::max<uint64_t>(1, uint64_t(p * double(kOne)));
-        sum += units[g];
-        if (units[g] > units[largest]) largest = g;
-    }
-    units[largest] += kOne - sum;  // kOne - sum is a few units: rounding, and the minimum of one
-    table->cdf[0] = 0;
-    for (uint32_t g = 0; g < kGroups; ++g) {
-        table->cdf[g + 1] = table->cdf[g] + units[g];
-        table->probability[g] = float(double(units[g]) / double(kOne));
-    }
-    return table;
+    std::vector<float> p(kGroups, 0.f);
+    for (uint32_t g = 0; g < kGroups; ++g)
+        if (!groups_[g].cells.empty())
+            p[g] = float((1.0 - options_.epsilon) * (total > 0 ? w[g] / total : groups_[g].mass / mass) +
+                         options_.epsilon * groups_[g].mass / mass);
+    return std::make_unique<GroupTable>(p);
 }
 
 const VisibilityEnvironmentSampler::GroupTable &VisibilityEnvironmentSampler::table(const LightSampleContext &ctx) const {
     return tables_.get(keys_.of(ctx), [this](uint32_t key) { return build(key); });
 }
 
-uint32_t VisibilityEnvironmentSampler::choose_group(const GroupTable &t, Vec2 u, uint64_t &rest) {
-    const uint64_t bits = AliasTable::bits_of(u);
-    // The group whose fixed-point interval holds the bits, and the bits' place inside it, rescaled to 48
-    // bits for the cell choice (about 48 − log2(1/P(g)) of them are random: plenty for the alias table).
-    const uint32_t g = uint32_t(std::upper_bound(t.cdf.begin() + 1, t.cdf.end(), bits) - (t.cdf.begin() + 1));
-    rest = uint64_t(((unsigned __int128)(bits - t.cdf[g]) << kFixedBits) / (t.cdf[g + 1] - t.cdf[g]));
-    return g;
-}
-
 void VisibilityEnvironmentSampler::prefetch(const LightSampleContext &ctx, Vec2 u) const {
+    // The group's choice reads a small table that stays in cache; what begin() then reads of the group's
+    // cells (their alias bin and cell index, in tables as large as the map's own) is fetched ahead.
     uint64_t rest;
-    const uint32_t g = choose_group(table(ctx), u, rest);
-    groups_[g].table.prefetch_bits(rest);
+    const Group &group = groups_[table(ctx).sample_bits(AliasTable::bits_of(u), rest)];
+    const uint32_t i = group.table.first_index(rest);
+    group.table.prefetch_bits(rest);
+    __builtin_prefetch(&group.cells[i]);
 }
 
 LightSampleStart VisibilityEnvironmentSampler::begin(const LightSampleContext &ctx, Vec2 u) const {
-    const GroupTable &t = table(ctx);
+    float group_pmf, cell_pmf;
     uint64_t rest;
-    const uint32_t g = choose_group(t, u, rest);
-    const Group &group = groups_[g];
+    const Group &group = groups_[table(ctx).sample_bits(AliasTable::bits_of(u), rest, &group_pmf)];
     Vec2 offset;
-    float pmf;
-    const uint32_t cell = group.cells[group.table.sample_bits(rest, offset, &pmf)];
+    const uint32_t cell = group.cells[group.table.sample_bits(rest, offset, &cell_pmf)];
     const int w = env_.sampling_width(), h = env_.sampling_height();
     LightSampleStart start{u};
     start.point = Vec2((float(cell % uint32_t(w)) + offset.x) / float(w), (float(cell / uint32_t(w)) + offset.y) / float(h));
-    start.density = t.probability[g] * pmf * float(w) * float(h);
+    start.density = group_pmf * cell_pmf * float(w) * float(h);
     env_.prefetch_lookup(start.point);
     return start;
 }
@@ -144,12 +122,14 @@ float VisibilityEnvironmentSampler::pdf(const LightSampleContext &ctx, const Dir
     const float pmf = group.table.pmf(local_index_[cell]);
     const int w = env_.sampling_width(), h = env_.sampling_height();
     return EnvironmentMapLight::solid_angle_density(
-        uv, table(ctx).probability[group_of_cell_[cell]] * pmf * float(w) * float(h));
+        uv, table(ctx).pmf(group_of_cell_[cell]) * pmf * float(w) * float(h));
 }
 
 std::vector<double> VisibilityEnvironmentSampler::group_probabilities(const LightSampleContext &ctx) const {
     const GroupTable &t = table(ctx);
-    return std::vector<double>(t.probability.begin(), t.probability.end());
+    std::vector<double> p(kGroups);
+    for (uint32_t g = 0; g < kGroups; ++g) p[g] = t.pmf(g);
+    return p;
 }
 
 void VisibilityEnvironmentSampler::end_pass() {

@@ -52,13 +52,9 @@ public:
     static constexpr uint32_t kGroups = VoxelGrid::kDirectionBins;
 
 private:
-    static constexpr int kFixedBits = 48;  // the group choice's probabilities in fixed point
-    // One table's choice among the groups: cumulative probabilities in fixed point (so that the bits left
-    // after the choice can be handed on, exactly rescaled, to the cell choice) and each group's probability.
-    struct GroupTable {
-        std::array<uint64_t, kGroups + 1> cdf;
-        std::array<float, kGroups> probability;
-    };
+    // One table's choice among the groups (an alias table: one cache line read per choice, and what is
+    // left of u's bits after it goes on to the choice of a cell).
+    using GroupTable = AliasTable;
     struct Group {
         std::vector<uint32_t> cells;  // the map's sampling cells in this group
         AliasTable table;             // over them, ∝ the map's own density
@@ -67,8 +63,6 @@ private:
     };
     std::unique_ptr<GroupTable> build(uint32_t key) const;
     const GroupTable &table(const LightSampleContext &ctx) const;
-    // The group u picks from table t, and u's bits left for the choice within it.
-    static uint32_t choose_group(const GroupTable &t, Vec2 u, uint64_t &rest);
 
     const EnvironmentMapLight &env_;
     const VisibilityMap &map_;

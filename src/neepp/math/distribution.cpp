@@ -115,19 +115,33 @@ AliasTable::AliasTable(const std::vector<float> &weights) {
     for (Bin &b : bins_) b.alias_pmf = bins_[b.alias].pmf;
 }
 
-uint32_t AliasTable::sample_bits(uint64_t bits48, Vec2 &offset, float *pmf_out) const {
+uint32_t AliasTable::choose(uint64_t bits48, double &rest, float *pmf_out) const {
     double frac;
     const uint32_t first = first_bin(bits48, frac);
     const Bin &b = bins_[first];
     // Keep the bin, or jump to its alias: chosen by selects, not a branch, since which way it goes is
     // random (a branch is mispredicted about as often as the bins are split).
     const bool keep = frac < double(b.threshold);
-    const double t = b.threshold, rest = (frac - select(keep, 0.0, t)) / select(keep, t, 1.0 - t);
+    const double t = b.threshold;
+    rest = (frac - select(keep, 0.0, t)) / select(keep, t, 1.0 - t);
     if (pmf_out) *pmf_out = select(keep, b.pmf, b.alias_pmf);
+    return select(keep, first, b.alias);
+}
+
+uint32_t AliasTable::sample_bits(uint64_t bits48, Vec2 &offset, float *pmf_out) const {
+    double rest;
+    const uint32_t i = choose(bits48, rest, pmf_out);
     // Split the leftover variate into two: its coarse part and its fine part scaled back up.
     double fine = rest * 4096.0;
     offset = Vec2(float(std::min(rest, 0.99999994)), float(std::min(fine - std::floor(fine), 0.99999994)));
-    return select(keep, first, b.alias);
+    return i;
+}
+
+uint32_t AliasTable::sample_bits(uint64_t bits48, uint64_t &rest48, float *pmf_out) const {
+    double rest;
+    const uint32_t i = choose(bits48, rest, pmf_out);
+    rest48 = std::min(uint64_t(rest * 0x1p48), (uint64_t(1) << 48) - 1);
+    return i;
 }
 
 }  // namespace neepp

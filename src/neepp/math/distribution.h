@@ -65,6 +65,9 @@ public:
     // The same from 48 random bits (a caller that spent some of u's bits on a choice of its own passes on
     // what is left, rescaled, instead of a float variate with fewer bits than the table needs).
     uint32_t sample_bits(uint64_t bits48, Vec2 &offset, float *pmf_out = nullptr) const;
+    // ... or with what is left of the bits after the choice (about 48 − log2(1/pmf) of them random) as 48
+    // bits for a choice that follows (a two-level distribution).
+    uint32_t sample_bits(uint64_t bits48, uint64_t &rest48, float *pmf_out = nullptr) const;
     // The 48 random bits sample(u) reads: the 24 mantissa bits of each sampler dimension.
     static uint64_t bits_of(Vec2 u) {
         return (uint64_t(double(u.x) * 0x1p24) << 24) | uint64_t(double(u.y) * 0x1p24);
@@ -72,12 +75,16 @@ public:
     float pmf(uint32_t i) const { return bins_[i].pmf; }
     // Cache prefetch of the bin sample(u) reads first (a batched caller's latency hiding; a hint only).
     void prefetch(Vec2 u) const { prefetch_bits(bits_of(u)); }
-    void prefetch_bits(uint64_t bits48) const {
+    void prefetch_bits(uint64_t bits48) const { __builtin_prefetch(&bins_[first_index(bits48)]); }
+    // The index 48 bits pick before the alias test: the one chosen unless its alias is (for a caller
+    // prefetching what it will read of that index).
+    uint32_t first_index(uint64_t bits48) const {
         double frac;
-        __builtin_prefetch(&bins_[first_bin(bits48, frac)]);
+        return first_bin(bits48, frac);
     }
 
 private:
+    uint32_t choose(uint64_t bits48, double &rest, float *pmf_out) const;
     // The bin 48 random bits pick before the alias test, and the fraction of it left for that test.
     uint32_t first_bin(uint64_t bits, double &frac) const {
         const unsigned __int128 scaled = (unsigned __int128)bits * bins_.size();
