@@ -11,7 +11,7 @@ const std::vector<std::pair<std::string, std::vector<std::string>>> &supported_p
                   "dielectric", "roughdielectric", "thindielectric", "principled", "principledthin", "null"}},
         {"texture", {"bitmap", "checkerboard"}},
         {"emitter", {"area", "envmap", "constant", "point", "spot", "directional"}},
-        {"sensor", {"perspective"}},
+        {"sensor", {"perspective", "orthographic"}},
         {"film", {"hdrfilm"}},
         {"rfilter", {"box", "tent", "gaussian"}},
         {"sampler", {"independent", "sobol"}},
