@@ -223,6 +223,30 @@ TEST(SceneLoader, TopLevelAreaEmittersLightTheShapesThatReferenceThem) {
     EXPECT_NE(msg.find("attached to no shape"), std::string::npos) << msg;
 }
 
+// A -D parameter the scene never substitutes is refused, naming it, as Mitsuba 3 refuses it ("unused
+// parameters"); a <default> alone does not use one, and a caller's own value (the CLI's --spp) may go unused.
+TEST(SceneErrors, UnusedDefinesAreRefused) {
+    const std::string path = write_temp_scene(
+        scene_with(std::string(kLight) + "\n<default name=\"r\" value=\"1\"/>\n<default name=\"unread\" value=\"1\"/>\n"
+                   "<shape type=\"sphere\"><float name=\"radius\" value=\"$r\"/></shape>"),
+        "defines.xml");
+    EXPECT_NO_THROW(load_scene(path, {{"r", "2"}}));
+    try {
+        load_scene(path, {{"r", "2"}, {"unread", "3"}, {"speling", "4"}});
+        ADD_FAILURE() << "unused defines were accepted";
+    } catch (const SceneError &e) {
+        const std::string msg = e.what();
+        EXPECT_NE(msg.find("defines.xml"), std::string::npos) << msg;
+        EXPECT_NE(msg.find("-D speling=4, -D unread=3"), std::string::npos) << msg;
+        EXPECT_EQ(msg.find("r=2"), std::string::npos) << msg;
+    }
+    EXPECT_NO_THROW(load_scene(path, {{"r", "2"}, {"spp", "8"}}, {"spp"}));
+    const std::vector<SceneProblem> problems = check_scene(path, {{"speling", "4"}});
+    ASSERT_EQ(problems.size(), 1u);
+    EXPECT_TRUE(problems[0].error);
+    EXPECT_NE(problems[0].problem.find("speling"), std::string::npos);
+}
+
 // The orthographic sensor loads with its clip distances and crop; bdpt and light tracing refuse it.
 TEST(SceneLoader, OrthographicSensorLoads) {
     const std::string xml = std::string("<scene version=\"3.0.0\">\n") +

@@ -236,7 +236,16 @@ struct SourceFile {
 class Parser {
 public:
     Parser(const std::map<std::string, std::string> &defines, std::string base_dir) : base_dir_(std::move(base_dir)) {
-        for (const auto &[k, v] : defines) add_param(k, v);
+        for (const auto &[k, v] : defines) add_param(k, v, false);
+    }
+
+    // The -D parameters no attribute substituted, as "name=value".
+    std::vector<std::string> unused_defines() const {
+        std::vector<std::string> out;
+        for (const Param &p : params_)
+            if (!p.used) out.push_back(p.key.substr(1) + "=" + p.value);
+        std::sort(out.begin(), out.end());
+        return out;
     }
 
     std::shared_ptr<XmlNode> parse(const std::string &path) {
@@ -258,6 +267,7 @@ public:
 private:
     struct Param {
         std::string key, value;  // key includes the '$'
+        bool used = true;        // a -D parameter starts unused; a <default> never counts as one
     };
 
     std::vector<Param> params_;  // longest key first, so "$resx2" is not substituted as "$resx" + "2"
@@ -265,8 +275,8 @@ private:
     std::string base_dir_;
     std::shared_ptr<std::vector<std::string>> search_dirs_ = std::make_shared<std::vector<std::string>>();
 
-    void add_param(const std::string &name, const std::string &value) {
-        Param p{"$" + name, value};
+    void add_param(const std::string &name, const std::string &value, bool from_default) {
+        Param p{"$" + name, value, from_default};
         auto pos = std::find_if(params_.begin(), params_.end(), [&](const Param &q) { return p.key.size() > q.key.size(); });
         params_.insert(pos, std::move(p));
     }
@@ -325,13 +335,14 @@ private:
         for (pugi::xml_attribute attr : el.attributes()) {
             std::string value = attr.value();
             if (value.find('$') == std::string::npos) continue;
-            for (const Param &p : params_) {
+            for (Param &p : params_) {
                 for (size_t pos = value.find(p.key); pos != std::string::npos; pos = value.find(p.key, pos)) {
                     if (pos > 0 && value[pos - 1] == '\\') {
                         pos += p.key.size();
                         continue;
                     }
                     value.replace(pos, p.key.size(), p.value);
+                    p.used = true;
                     pos += p.value.size();
                 }
             }
@@ -521,7 +532,7 @@ private:
             check_attributes(src, el, {"!name", "!value"});
             std::string name = el.attribute("name").value();
             if (name.empty()) fail(src, el, "<default> needs a non-empty name");
-            if (!has_param(name)) add_param(name, el.attribute("value").value());
+            if (!has_param(name)) add_param(name, el.attribute("value").value(), true);
             return;
         } else if (tag == "alias") {
             check_attributes(src, el, {"!id", "!as"});
@@ -640,11 +651,25 @@ private:
 
 }  // namespace
 
-std::shared_ptr<XmlNode> parse_mitsuba_xml(const std::string &path, const std::map<std::string, std::string> &defines) {
+std::shared_ptr<XmlNode> parse_mitsuba_xml(const std::string &path, const std::map<std::string, std::string> &defines,
+                                           std::vector<std::string> *unused_defines) {
     // Like Mitsuba's file resolver, relative file names resolve against the top-level scene's folder
     // (also for objects from included files).
     std::string dir = fs::absolute(fs::path(path)).parent_path().lexically_normal().string();
-    return Parser(defines, dir).parse(path);
+    Parser parser(defines, dir);
+    std::shared_ptr<XmlNode> root = parser.parse(path);
+    std::vector<std::string> unused = parser.unused_defines();
+    if (unused_defines) *unused_defines = std::move(unused);
+    else if (!unused.empty()) throw SceneError(path, unused_parameters_problem(unused));
+    return root;
+}
+
+std::string unused_parameters_problem(const std::vector<std::string> &unused) {
+    std::string list;
+    for (const std::string &u : unused) list += (list.empty() ? "-D " : ", -D ") + u;
+    return std::string("unused parameter") + (unused.size() == 1 ? "" : "s") + " " + list +
+           ": the scene substitutes no such $name (a misspelt -D would otherwise be ignored; Mitsuba 3 refuses "
+           "it too)";
 }
 
 }  // namespace neepp

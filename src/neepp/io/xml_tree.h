@@ -83,8 +83,13 @@ private:
 };
 
 // Parses a Mitsuba 3 scene file. `defines` are the -D name=value parameters; they take precedence
-// over the file's <default> values. Throws SceneError (file:line: problem) on any error.
+// over the file's <default> values. Throws SceneError (file:line: problem) on any error. A define that
+// no attribute substitutes is refused as Mitsuba 3 refuses it; when `unused_defines` is given, such
+// defines ("name=value") are put there instead, for the caller to judge.
 std::shared_ptr<XmlNode> parse_mitsuba_xml(const std::string &path,
-                                           const std::map<std::string, std::string> &defines = {});
+                                           const std::map<std::string, std::string> &defines = {},
+                                           std::vector<std::string> *unused_defines = nullptr);
+// The problem text for unused defines ("name=value" each).
+std::string unused_parameters_problem(const std::vector<std::string> &unused);
 
 }  // namespace neepp

@@ -104,9 +104,13 @@ void load_sensor(const XmlNode &sensor, Scene &scene) {
 }
 
 
-std::unique_ptr<Scene> read_scene(const std::string &path, const std::map<std::string, std::string> &defines) {
+std::unique_ptr<Scene> read_scene(const std::string &path, const std::map<std::string, std::string> &defines,
+                                  const std::set<std::string> &may_be_unused) {
     using loader::attempt;
-    std::shared_ptr<XmlNode> root = parse_mitsuba_xml(path, defines);
+    std::vector<std::string> unused;
+    std::shared_ptr<XmlNode> root = parse_mitsuba_xml(path, defines, &unused);
+    std::erase_if(unused, [&](const std::string &u) { return may_be_unused.count(u.substr(0, u.find('='))) != 0; });
+    if (!unused.empty()) attempt([&] { throw SceneError(path, unused_parameters_problem(unused)); });
     auto scene = std::make_unique<Scene>();
     scene->source_path = path;
     loader::Factories factories;
@@ -153,8 +157,9 @@ std::unique_ptr<Scene> read_scene(const std::string &path, const std::map<std::s
 
 }  // namespace
 
-std::unique_ptr<Scene> load_scene(const std::string &path, const std::map<std::string, std::string> &defines) {
-    auto scene = read_scene(path, defines);
+std::unique_ptr<Scene> load_scene(const std::string &path, const std::map<std::string, std::string> &defines,
+                                  const std::set<std::string> &may_be_unused) {
+    auto scene = read_scene(path, defines, may_be_unused);
     try {
         scene->build();
     } catch (const std::exception &e) {
@@ -163,11 +168,12 @@ std::unique_ptr<Scene> load_scene(const std::string &path, const std::map<std::s
     return scene;
 }
 
-std::vector<SceneProblem> check_scene(const std::string &path, const std::map<std::string, std::string> &defines) {
+std::vector<SceneProblem> check_scene(const std::string &path, const std::map<std::string, std::string> &defines,
+                                     const std::set<std::string> &may_be_unused) {
     std::vector<SceneProblem> problems;
     loader::CheckingScope scope(problems);
     try {
-        read_scene(path, defines);  // the BVH is not built: it cannot fail where loading succeeded
+        read_scene(path, defines, may_be_unused);  // the BVH is not built: it cannot fail where loading succeeded
     } catch (const SceneError &e) {  // what stops even a check (a malformed XML file)
         loader::record(e);
     }
