@@ -1,6 +1,7 @@
 // Mitsuba 3 XML reader. The rules follow Mitsuba 3.9's src/core/parser.cpp: attribute checks,
 // $parameter substitution, <default>, transform composition, <ref>/<alias>/<include>.
 #include "neepp/io/xml_tree.h"
+#include "neepp/math/spectrum.h"
 
 #include <algorithm>
 #include <charconv>
@@ -26,6 +27,7 @@ const char *kind_name(XmlProperty::Kind kind) {
         case XmlProperty::Kind::Boolean: return "boolean";
         case XmlProperty::Kind::String: return "string";
         case XmlProperty::Kind::RGB: return "rgb";
+        case XmlProperty::Kind::Spectrum: return "spectrum";
         case XmlProperty::Kind::Vector: return "vector";
         case XmlProperty::Kind::Point: return "point";
         case XmlProperty::Kind::Transform: return "transform";
@@ -70,10 +72,15 @@ std::string as_string(const XmlNode &n, const std::string &prop, const XmlProper
     return p.s;
 }
 
-// Mitsuba accepts a plain float wherever a spectrum is expected and treats it as a grey constant.
-Color as_rgb(const XmlNode &n, const std::string &prop, const XmlProperty &p) {
+// Mitsuba accepts a plain float wherever a spectrum is expected and treats it as a grey constant. A
+// <spectrum> becomes RGB as Mitsuba's RGB variants make it: as emission when an emitter reads it.
+Color as_rgb(const XmlNode &n, const std::string &prop, const XmlProperty &p, bool unbounded = false) {
     if (p.kind == Kind::RGB) return p.v;
     if (p.kind == Kind::Float) return Color(float(p.f));
+    if (p.kind == Kind::Spectrum)
+        return spectrum_to_rgb(p.spectrum, n.tag == "emitter" ? SpectrumUse::Emission
+                                           : unbounded        ? SpectrumUse::Unbounded
+                                                              : SpectrumUse::Reflectance);
     wrong_kind(n, prop, p, "rgb, spectrum or float");
 }
 
@@ -122,6 +129,10 @@ Color XmlNode::get_rgb(const std::string &prop) const { return as_rgb(*this, pro
 Color XmlNode::get_rgb(const std::string &prop, const Color &def) const {
     const XmlProperty *p = find(prop, false);
     return p ? as_rgb(*this, prop, *p) : def;
+}
+Color XmlNode::get_unbounded_rgb(const std::string &prop, const Color &def) const {
+    const XmlProperty *p = find(prop, false);
+    return p ? as_rgb(*this, prop, *p, true) : def;
 }
 Vec3 XmlNode::get_vector(const std::string &prop) const { return as_vector(*this, prop, *find(prop, true)); }
 Vec3 XmlNode::get_vector(const std::string &prop, const Vec3 &def) const {
@@ -507,13 +518,16 @@ private:
             else if (tokens.size() == 3) p.v = three_numbers(src, el, "value");
             else fail(src, el, "<rgb> needs one or three values, got " + std::to_string(tokens.size()));
         } else if (tag == "spectrum") {
+            // Kept as a spectrum: whether it is a reflectance or an emission decides its RGB.
             check_attributes(src, el, {"!name", "value", "filename"});
-            p.kind = Kind::RGB;
-            auto tokens = tokenize(el.attribute("value").value());
-            // Wavelength:value pairs and spectrum files need a spectral-to-RGB conversion we lack.
-            if (el.attribute("filename") || tokens.size() != 1 || tokens[0].find(':') != std::string_view::npos)
-                fail(src, el, "only a constant <spectrum value=\"x\"> is supported (use <rgb> instead)");
-            p.v = Vec3(float(number(src, el, tokens[0], "spectrum")));
+            p.kind = Kind::Spectrum;
+            const pugi::xml_attribute value = el.attribute("value"), file = el.attribute("filename");
+            if (bool(value) == bool(file)) fail(src, el, "<spectrum> needs either \"value\" or \"filename\" (not both)");
+            try {
+                p.spectrum = value ? parse_spectrum(value.value()) : read_spectrum_file(parent.resolve_path(file.value()));
+            } catch (const std::exception &e) {
+                fail(src, el, std::string("<spectrum>: ") + e.what());
+            }
         } else if (tag == "vector" || tag == "point") {
             check_attributes(src, el, {"!name", "value", "x", "y", "z"});
             p.kind = tag == "vector" ? Kind::Vector : Kind::Point;

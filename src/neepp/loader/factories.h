@@ -15,8 +15,9 @@ class Factories {
 public:
     TexturePtr texture(const XmlNode &node);
     // The parameter `name` of node as a texture: a nested texture, an rgb/float/spectrum constant, or def.
-    TexturePtr texture_param(const XmlNode &node, const std::string &name, Color def);
-    TexturePtr texture_param_or_null(const XmlNode &node, const std::string &name);
+    // unbounded: a spectrum is not clamped to [0, 1] (Mitsuba's get_unbounded_texture, e.g. a conductor's eta).
+    TexturePtr texture_param(const XmlNode &node, const std::string &name, Color def, bool unbounded = false);
+    TexturePtr texture_param_or_null(const XmlNode &node, const std::string &name, bool unbounded = false);
     BSDFPtr bsdf(const XmlNode &node);
     BSDFPtr default_bsdf();
     BSDFPtr black_bsdf();  // an emitter's default
