@@ -41,6 +41,9 @@ private:
 void load_integrator(const XmlNode &node, RenderSettings &settings);
 // Reports properties that no builder read (misspelt or unsupported) on stderr, as Mitsuba does.
 void warn_unused(const XmlNode &node);
+// A perspective projection's angle of view (a perspective sensor's, a projector's): fov along fov_axis,
+// or Mitsuba 3's default from focal_length.
+void load_fov(const XmlNode &node, Camera &cam);
 // An IOR given as a number or a name from Mitsuba's table ("bk7", "air"...).
 float ior_param(const XmlNode &node, const std::string &name, float def);
 

@@ -10,6 +10,30 @@
 #include "neepp/loader/problems.h"
 
 namespace neepp {
+
+namespace loader {
+
+void load_fov(const XmlNode &sensor, Camera &cam) {
+    if (sensor.has("fov")) {
+        cam.fov = sensor.get_float("fov");
+        cam.fov_axis = sensor.get_string("fov_axis", "x");
+        return;
+    }
+    // fov_axis is then left unread, as Mitsuba does (it refuses the scene, neepp warns).
+    // Mitsuba 3's default: a focal length (35 mm film equivalent, 50mm unless given), which sets the
+    // angle across the 36 x 24 mm frame's diagonal, applied to the film's diagonal whatever fov_axis
+    // says (a square film gets 34.0° in x, a 3:2 one 39.6°).
+    const std::string text = sensor.get_string("focal_length", "50mm");
+    char *end = nullptr;
+    const float f = std::strtof(text.c_str(), &end);
+    if (end == text.c_str() || !(std::string(end).empty() || std::string(end) == "mm") || !(f > 0) || !std::isfinite(f))
+        throw sensor.error("focal_length '" + text + "' is not a length in millimetres (e.g. 50mm)");
+    cam.fov = 2.f * std::atan(std::sqrt(36.f * 36.f + 24.f * 24.f) / (2.f * f)) * 180.f / kPi;
+    cam.fov_axis = "diagonal";
+}
+
+}  // namespace loader
+
 namespace {
 
 void load_film(const XmlNode &film, Scene &scene) {
@@ -53,32 +77,12 @@ void load_film(const XmlNode &film, Scene &scene) {
     loader::warn_unused(film);
 }
 
-// The perspective camera's angle of view: fov along fov_axis, or Mitsuba 3's default.
-void load_fov(const XmlNode &sensor, Camera &cam) {
-    if (sensor.has("fov")) {
-        cam.fov = sensor.get_float("fov");
-        cam.fov_axis = sensor.get_string("fov_axis", "x");
-        return;
-    }
-    // fov_axis is then left unread, as Mitsuba does (it refuses the scene, neepp warns).
-    // Mitsuba 3's default: a focal length (35 mm film equivalent, 50mm unless given), which sets the
-    // angle across the 36 x 24 mm frame's diagonal, applied to the film's diagonal whatever fov_axis
-    // says (a square film gets 34.0° in x, a 3:2 one 39.6°).
-    const std::string text = sensor.get_string("focal_length", "50mm");
-    char *end = nullptr;
-    const float f = std::strtof(text.c_str(), &end);
-    if (end == text.c_str() || !(std::string(end).empty() || std::string(end) == "mm") || !(f > 0) || !std::isfinite(f))
-        throw sensor.error("focal_length '" + text + "' is not a length in millimetres (e.g. 50mm)");
-    cam.fov = 2.f * std::atan(std::sqrt(36.f * 36.f + 24.f * 24.f) / (2.f * f)) * 180.f / kPi;
-    cam.fov_axis = "diagonal";
-}
-
 void load_sensor(const XmlNode &sensor, Scene &scene) {
     if (sensor.type != "perspective" && sensor.type != "orthographic")
         throw sensor.error("unsupported sensor '" + sensor.type + "' (supported: " + supported_list("sensor") + ")");
     Camera &cam = scene.camera;
     cam.to_world = sensor.get_transform("to_world");
-    if (sensor.type == "perspective") load_fov(sensor, cam);
+    if (sensor.type == "perspective") loader::load_fov(sensor, cam);
     else cam.projection = Projection::Orthographic;
     cam.near_clip = sensor.get_float("near_clip", 1e-2f);
     cam.far_clip = sensor.get_float("far_clip", 1e4f);

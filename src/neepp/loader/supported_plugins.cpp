@@ -10,7 +10,7 @@ const std::vector<std::pair<std::string, std::vector<std::string>>> &supported_p
         {"bsdf", {"diffuse", "twosided", "mask", "bumpmap", "conductor", "roughconductor", "plastic", "roughplastic",
                   "dielectric", "roughdielectric", "thindielectric", "principled", "principledthin", "null"}},
         {"texture", {"bitmap", "checkerboard"}},
-        {"emitter", {"area", "envmap", "constant", "point", "spot", "directional"}},
+        {"emitter", {"area", "envmap", "constant", "point", "spot", "directional", "projector"}},
         {"sensor", {"perspective", "orthographic"}},
         {"film", {"hdrfilm"}},
         {"rfilter", {"box", "tent", "gaussian"}},
