@@ -135,10 +135,15 @@ Rendered run_render(const RenderArgs &a) {
     if (!a.visibility_map.empty()) check_output_path(a.visibility_map, "visibility map", nullptr);
     std::map<std::string, std::string> defines;
     for (auto &d : a.defines) defines.insert(split_key_value(d, "-D"));
-    if (a.spp > 0 && !defines.count("spp")) defines["spp"] = std::to_string(a.spp);
+    // --spp also fills a scene's $spp (and sets the count itself below, so a scene without one still gets it).
+    std::set<std::string> own;
+    if (a.spp > 0 && !defines.count("spp")) {
+        defines["spp"] = std::to_string(a.spp);
+        own.insert("spp");
+    }
     // Loading (parsing, meshes, textures, the BVH) is timed apart from rendering, as Mitsuba's load is.
     const auto load_start = std::chrono::steady_clock::now();
-    auto scene = neepp::load_scene(a.scene, defines);
+    auto scene = neepp::load_scene(a.scene, defines, own);
     const double load_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - load_start).count();
     if (!a.rfilter.empty()) {  // e.g. box, so a low-resolution render matches a box-downsampled reference
         scene->settings.rfilter = a.rfilter;

@@ -33,10 +33,11 @@ void bind_scene(nb::module_ &m) {
         .def_prop_ro("width", [](const Scene &s) { return s.camera.width; }, "Film width in pixels.")
         .def_prop_ro("height", [](const Scene &s) { return s.camera.height; }, "Film height in pixels.")
         .def_prop_ro("camera", [](const Scene &s) {
-                const PerspectiveCamera &c = s.camera;
+                const Camera &c = s.camera;
                 nb::list rows;
                 for (const auto &row : c.to_world.matrix.m) rows.append(nb::make_tuple(row[0], row[1], row[2], row[3]));
                 nb::dict d;
+                d["type"] = c.projection == Projection::Orthographic ? "orthographic" : "perspective";
                 d["position"] = vec(c.position());
                 d["to_world"] = rows;
                 d["fov"] = c.fov;
@@ -47,7 +48,7 @@ void bind_scene(nb::module_ &m) {
                 d["height"] = c.height;
                 return d;
             },
-            "The perspective camera: position, to_world (4x4 rows), fov in degrees along fov_axis, clip distances, film size.")
+            "The camera: type (perspective, orthographic), position, to_world (4x4 rows), fov in degrees along fov_axis (perspective), clip distances, film size.")
         .def_prop_ro("lights", [](const Scene &s) {
                 nb::list lights;
                 for (const auto &light : s.lights()) {

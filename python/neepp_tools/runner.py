@@ -152,8 +152,6 @@ def run_neepp(scene, out_exr, *, spp: int | None = None, time_s: float | None = 
         d["resy"] = resy
     if max_depth is not None:
         d["max_depth"] = max_depth
-    if spp is not None:
-        d.setdefault("spp", spp)
     for k, v in d.items():
         cmd += ["-D", f"{k}={v}"]
     for k, v in (integrator_args or {}).items():

@@ -35,7 +35,7 @@ void expect_batch_equals_single(const Options &options) {
     auto scene = load_scene(write_temp_scene(room_xml()));
     auto integrator = make_integrator("path", options);
     integrator->prepare(*scene);
-    const PerspectiveCamera &cam = scene->camera;
+    const Camera &cam = scene->camera;
     // 150 samples: several full batches and a partial one, whatever the integrator's batch size.
     constexpr int kSamples = 150;
     std::vector<std::unique_ptr<Sampler>> owned;

@@ -303,3 +303,39 @@ TEST(XmlTree, ErrorsNameFileAndLine) {
         EXPECT_EQ(std::string(e.what()).rfind(missing + ":", 0), 0u) << e.what();
     }
 }
+
+// <spectrum>: pairs, a .spd file (found as other files are) and a constant, converted as Mitsuba 3's RGB
+// variants convert them (their values against Mitsuba's: tests/python/test_spectrum_vs_mitsuba.py): a
+// reflectance under D65 (a flat 1 is white, clamped to [0, 1]), an emitter's as emission (a flat 1 is
+// equal-energy light, purple-ish in sRGB); bad ones are errors at their line.
+TEST(XmlTree, SpectraBecomeRgbAsMitsubasRgbVariantsMakeThem) {
+    TempDir tmp;
+    tmp.write("flat.spd", "# flat\n360 1\n\n830 1\n");
+    std::string path = tmp.write("s.xml", scene(R"(<bsdf type="diffuse" id="b"><spectrum name="r" value="360:1, 830:1"/>
+  <spectrum name="f" filename="flat.spd"/><spectrum name="c" value="0.5"/><spectrum name="hot" value="550:3, 600:5"/>
+  <spectrum name="eta" value="550:3, 600:5"/></bsdf>
+<emitter type="constant" id="e"><spectrum name="r" value="360:1, 830:1"/><spectrum name="c" value="0.5"/></emitter>
+)"));
+    auto root = parse_mitsuba_xml(path);
+    const XmlNode &b = *root->children.at(0), &e = *root->children.at(1);
+    expect_near(b.get_rgb("r"), Vec3(0.998985f, 0.998874f, 0.998802f));  // Mitsuba 3.9.1's values
+    expect_near(b.get_rgb("f"), b.get_rgb("r"));
+    expect_near(b.get_rgb("c"), Vec3(0.5f));
+    expect_near(b.get_rgb("hot"), Vec3(1.f, 1.f, 0.f));
+    expect_near(b.get_unbounded_rgb("eta", Vec3(0.f)), Vec3(2.452148f, 1.486868f, 0.f));
+    expect_near(e.get_rgb("r"), Vec3(1.204884f, 0.948228f, 0.909267f));
+    expect_near(e.get_rgb("c"), Vec3(0.602397f, 0.474146f, 0.454458f));  // 0.5 x XYZ (1, 1, 1) in sRGB
+
+    auto check = [&](const std::string &body, const std::string &needle) {
+        std::string p = tmp.write("e.xml", scene("<bsdf type=\"diffuse\">\n" + body + "</bsdf>\n"));
+        expect_error([&] { parse_mitsuba_xml(p); }, p, 3, needle);
+    };
+    check("<spectrum name=\"r\" value=\"500:0.1, 400:0.2\"/>", "must increase");
+    check("<spectrum name=\"r\" value=\"500:0.1\"/>", "at least two");
+    check("<spectrum name=\"r\" value=\"500:0.1, 600\"/>", "not a wavelength:value pair");
+    check("<spectrum name=\"r\" value=\"400:x, 600:1\"/>", "could not parse spectrum value \"x\"");
+    check("<spectrum name=\"r\" filename=\"none.spd\"/>", "cannot open spectrum file");
+    check("<spectrum name=\"r\" value=\"1\" filename=\"flat.spd\"/>", "either");
+    tmp.write("bad.spd", "400 1\n500 1 2\n");
+    check("<spectrum name=\"r\" filename=\"bad.spd\"/>", "line 2");
+}

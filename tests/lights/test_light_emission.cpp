@@ -6,6 +6,7 @@
 #include "neepp/lights/area_light.h"
 #include "neepp/lights/directional_light.h"
 #include "neepp/lights/environment_light.h"
+#include "neepp/lights/projector_light.h"
 #include "neepp/lights/spot_light.h"
 #include "neepp/math/frame.h"
 #include "neepp/materials/texture.h"
@@ -50,11 +51,12 @@ void expect_round_trip(const Light &light, int n = 20000) {
 }
 
 // Directions emitted from one fixed origin (u_pos held), against pdf_emission's direction density there.
-Chi2Result chi2_directions(const Light &light, Vec2 u_pos) {
+// ires: each cell's pdf integral from ires x ires points (more where the density has edges across cells).
+Chi2Result chi2_directions(const Light &light, Vec2 u_pos, int ires = 8) {
     const EmissionSample at = light.sample_emission(u_pos, Vec2(0.5f, 0.5f));
     SphereChi2Config cfg;
     cfg.res = 40;
-    cfg.ires = 8;
+    cfg.ires = ires;
     cfg.sample_count = 300000;
     return chi2_sphere_test(
         [&](PCG32 &rng) -> std::optional<Vec3> {
@@ -209,4 +211,51 @@ TEST(LightEmission, DirectionalLightEmitsParallelRaysAcrossTheScene) {
     EXPECT_FLOAT_EQ(radiance.x, 2.f);
     EXPECT_EQ(light.eval_environment(-travel), Color(0.f));  // nothing can hit a delta
     EXPECT_THROW(DirectionalLight(Vec3(0.f), Color(1.f)), std::invalid_argument);
+}
+
+namespace {
+
+ProjectorLight tilted_projector(float fov, const std::string &axis, int w, int h) {
+    Camera frame;
+    frame.to_world = Transform::look_at(Vec3(0.5f, 2.f, -1.f), Vec3(0.2f, 0.f, 0.3f), Vec3(0, 1, 0));
+    frame.fov = fov;
+    frame.fov_axis = axis;
+    frame.width = w;
+    frame.height = h;
+    return ProjectorLight(frame, constant_texture(Color(0.8f, 0.6f, 0.4f)), 1.5f);
+}
+
+}  // namespace
+
+// Mitsuba's projector: its rays cover the image plane uniformly (chi-square against pdf_emission, which
+// is the perspective camera's 1 / (A cos^3)), carry pi scale E / cos^3, and add up to the power it
+// reports (pi scale E A); seen from a point, a delta bringing pi scale E / (z^2 cos), Mitsuba's formula;
+// nothing outside its frustum.
+TEST(LightEmission, ProjectorLightEmitsItsImageThroughThePerspectiveMapping) {
+    for (auto [fov, axis, w, h] : {std::tuple{40.f, "x", 1, 1}, std::tuple{70.f, "y", 6, 3}, std::tuple{120.f, "x", 2, 5}}) {
+        const ProjectorLight light = tilted_projector(fov, axis, w, h);
+        expect_round_trip(light);
+        // The frustum's straight edges cut cells anywhere: their integrals need many points.
+        const Chi2Result r = chi2_directions(light, Vec2(0.5f, 0.5f), 48);
+        ASSERT_TRUE(r.error.empty()) << r.describe();
+        EXPECT_GT(r.p_value, 1e-4) << r.describe();
+        EXPECT_NEAR(mean_flux(light), luminance(light.power()), 2e-3 * luminance(light.power())) << fov;
+    }
+    const ProjectorLight light = tilted_projector(40.f, "x", 1, 1);
+    const Vec3 origin(0.5f, 2.f, -1.f), axis = normalize(Vec3(0.2f, 0.f, 0.3f) - origin);
+    const Frame f(axis);
+    const float tan_x = std::tan(20.f * kPi / 180.f);
+    Color radiance;
+    for (float t : {0.f, 0.5f, 0.95f}) {  // along the image's x: cos theta = 1 / sqrt(1 + (t tan_x)^2)
+        const Vec3 local_dir = normalize(f.n + f.s * (t * tan_x));
+        const float cos_theta = dot(local_dir, axis), dist = 2.5f, z = dist * cos_theta;
+        const DirectionSample ds = light.sample_direction(origin + local_dir * dist, Vec2(0.3f, 0.3f), radiance);
+        EXPECT_TRUE(ds.delta);
+        EXPECT_NEAR(radiance.x, kPi * 1.5f * 0.8f / (z * z * cos_theta), 1e-4f) << t;
+    }
+    light.sample_direction(origin + normalize(f.n + f.s * (1.05f * tan_x)) * 2.f, Vec2(0.3f, 0.3f), radiance);
+    EXPECT_TRUE(is_black(radiance));  // just outside the image
+    light.sample_direction(origin - axis * 2.f, Vec2(0.3f, 0.3f), radiance);
+    EXPECT_TRUE(is_black(radiance));  // behind it
+    EXPECT_THROW(tilted_projector(180.f, "x", 1, 1), std::invalid_argument);
 }

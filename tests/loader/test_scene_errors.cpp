@@ -263,3 +263,58 @@ TEST(SceneLoader, TopLevelAreaEmittersLightTheShapesThatReferenceThem) {
     EXPECT_NE(msg.find("unref.xml:4:"), std::string::npos) << msg;
     EXPECT_NE(msg.find("attached to no shape"), std::string::npos) << msg;
 }
+
+// A -D parameter the scene never substitutes is refused, naming it, as Mitsuba 3 refuses it ("unused
+// parameters"); a <default> alone does not use one, and a caller's own value (the CLI's --spp) may go unused.
+TEST(SceneErrors, UnusedDefinesAreRefused) {
+    const std::string path = write_temp_scene(
+        scene_with(std::string(kLight) + "\n<default name=\"r\" value=\"1\"/>\n<default name=\"unread\" value=\"1\"/>\n"
+                   "<shape type=\"sphere\"><float name=\"radius\" value=\"$r\"/></shape>"),
+        "defines.xml");
+    EXPECT_NO_THROW(load_scene(path, {{"r", "2"}}));
+    try {
+        load_scene(path, {{"r", "2"}, {"unread", "3"}, {"speling", "4"}});
+        ADD_FAILURE() << "unused defines were accepted";
+    } catch (const SceneError &e) {
+        const std::string msg = e.what();
+        EXPECT_NE(msg.find("defines.xml"), std::string::npos) << msg;
+        EXPECT_NE(msg.find("-D speling=4, -D unread=3"), std::string::npos) << msg;
+        EXPECT_EQ(msg.find("r=2"), std::string::npos) << msg;
+    }
+    EXPECT_NO_THROW(load_scene(path, {{"r", "2"}, {"spp", "8"}}, {"spp"}));
+    const std::vector<SceneProblem> problems = check_scene(path, {{"speling", "4"}});
+    ASSERT_EQ(problems.size(), 1u);
+    EXPECT_TRUE(problems[0].error);
+    EXPECT_NE(problems[0].problem.find("speling"), std::string::npos);
+}
+
+// The orthographic sensor loads with its clip distances and crop; bdpt and light tracing refuse it.
+TEST(SceneLoader, OrthographicSensorLoads) {
+    const std::string xml = std::string("<scene version=\"3.0.0\">\n") +
+                            "<sensor type=\"orthographic\"><float name=\"near_clip\" value=\"0.5\"/>"
+                            "<transform name=\"to_world\"><scale value=\"3\"/></transform>"
+                            "<film type=\"hdrfilm\"><integer name=\"width\" value=\"8\"/><integer name=\"height\" value=\"4\"/>"
+                            "<integer name=\"crop_width\" value=\"4\"/></film></sensor>\n" +
+                            kLight + "\n<shape type=\"sphere\"/>\n</scene>\n";
+    auto scene = load_scene(write_temp_scene(xml, "ortho.xml"));
+    EXPECT_EQ(scene->camera.projection, Projection::Orthographic);
+    EXPECT_EQ(scene->camera.width, 4);
+    EXPECT_EQ(scene->camera.film_width, 8);
+    const Ray r = scene->camera.generate_ray(Vec2(0.5f, 0.5f));  // the crop's centre: a quarter of the film
+    EXPECT_NEAR(r.o.x, 1.5f, 1e-5f);                             // camera x 0.5, scaled by 3
+    EXPECT_NEAR(r.o.z, 1.5f, 1e-5f);                             // the near plane, scaled too
+    EXPECT_NE(load_error(std::string("<scene version=\"3.0.0\">\n<sensor type=\"orthographic\">"
+                                     "<float name=\"near_clip\" value=\"0\"/></sensor>\n") +
+                             kLight + "\n</scene>\n")
+                  .find("near_clip must be greater than zero"),
+              std::string::npos);
+    const std::string ortho_path = write_temp_scene(xml, "ortho_bdpt.xml");
+    for (const char *integrator : {"bdpt", "light"}) {
+        try {
+            render_scene_file(ortho_path, 1, 1, Options{}, integrator);
+            ADD_FAILURE() << integrator << " rendered an orthographic sensor";
+        } catch (const std::invalid_argument &e) {
+            EXPECT_NE(std::string(e.what()).find("orthographic"), std::string::npos) << e.what();
+        }
+    }
+}

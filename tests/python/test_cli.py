@@ -145,11 +145,24 @@ def test_bad_scene_gives_a_clear_error(neepp_bin, tmp_path, xml, expect):
     (["--integrator", "warp-drive"], "warp-drive"),
     (["-D", "resx=abc"], "abc"),
     (["--sampler", "magic"], "magic"),
+    (["-D", "rexs=32"], "unused parameter -D rexs=32"),  # Mitsuba 3 refuses a -D the scene never uses
 ])
 def test_bad_options_give_a_clear_error(neepp_bin, tmp_path, args, expect):
     r = run(neepp_bin, "render", DEMO, "-o", tmp_path / "x.exr", "--spp", 1, *args, timeout=30)
     assert r.returncode != 0 and r.returncode < 128, r.stderr
     assert expect in r.stderr, r.stderr
+
+
+def test_spp_fills_only_a_scene_that_asks_for_it(neepp_bin, tmp_path):
+    # --spp sets $spp where the scene has one, and is no unused -D where it has none.
+    xml = tmp_path / "plain.xml"
+    xml.write_text("""<scene version="3.0.0"><sensor type="perspective"><film type="hdrfilm">
+  <integer name="width" value="8"/><integer name="height" value="8"/></film></sensor>
+  <emitter type="constant"/><shape type="sphere"/></scene>""")
+    r = run(neepp_bin, "render", xml, "-o", tmp_path / "x.exr", "--spp", 2, "--quiet", timeout=30)
+    assert r.returncode == 0, r.stderr
+    r = run(neepp_bin, "check", xml, "-D", "spp=2", timeout=30)
+    assert r.returncode == 1 and "unused parameter -D spp=2" in r.stdout, r.stdout + r.stderr
 
 
 def test_output_folders_are_created(neepp_bin, tmp_path):

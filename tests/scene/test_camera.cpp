@@ -10,8 +10,8 @@ using namespace neepp;
 
 namespace {
 
-PerspectiveCamera camera(bool cropped) {
-    PerspectiveCamera c;
+Camera camera(bool cropped) {
+    Camera c;
     c.to_world = Transform::look_at(Vec3(1, 2, 3), Vec3(0, 0, 0), Vec3(0, 1, 0));
     c.width = 64;
     c.height = 48;
@@ -28,7 +28,7 @@ TEST(Camera, DirectionDensityIntegratesToOneOverTheImage) {
     // uniform over a rectangle 1.2 times the film's: pdf must be 1 / (the image's area there) inside it.
     const float tx = std::tan(25.f * kPi / 180.f) * 1.2f, ty = tx * 48.f / 64.f;
     for (bool cropped : {false, true}) {
-        const PerspectiveCamera c = camera(cropped);
+        const Camera c = camera(cropped);
         PCG32 rng(7, 1);
         const int n = 400000;
         double sum = 0;
@@ -46,7 +46,7 @@ TEST(Camera, DirectionDensityIntegratesToOneOverTheImage) {
 
 TEST(Camera, AConnectionLandsWhereItsRayStarts) {
     for (bool cropped : {false, true}) {
-        const PerspectiveCamera c = camera(cropped);
+        const Camera c = camera(cropped);
         PCG32 rng(3, 1);
         for (int i = 0; i < 1000; ++i) {
             const Vec2 u(rng.next_float(), rng.next_float());
@@ -60,7 +60,7 @@ TEST(Camera, AConnectionLandsWhereItsRayStarts) {
 }
 
 TEST(Camera, ACropsPixelTracesTheWholeFilmsRay) {
-    const PerspectiveCamera whole = camera(false), cropped = camera(true);
+    const Camera whole = camera(false), cropped = camera(true);
     EXPECT_EQ(cropped.width, 20);
     EXPECT_EQ(cropped.height, 30);
     for (int y = 0; y < 30; ++y)
@@ -76,7 +76,7 @@ TEST(Camera, ACropsPixelTracesTheWholeFilmsRay) {
 }
 
 TEST(Camera, ACropOutsideTheImageIsRefused) {
-    PerspectiveCamera c = camera(false);
+    Camera c = camera(false);
     EXPECT_THROW(c.crop(60, 0, 10, 10), std::invalid_argument);
     EXPECT_THROW(c.crop(0, 0, 0, 10), std::invalid_argument);
     EXPECT_THROW(c.crop(-1, 0, 10, 10), std::invalid_argument);
@@ -85,4 +85,49 @@ TEST(Camera, ACropOutsideTheImageIsRefused) {
     EXPECT_EQ(c.crop_x, 12);
     EXPECT_EQ(c.crop_y, 10);
     EXPECT_EQ(c.film_width, 64);
+}
+
+// Orthographic: parallel rays along the view axis from the near plane, over x in [-1, 1] and y in
+// [-1/aspect, 1/aspect] of camera space scaled by to_world; a crop keeps the whole film's rays; no
+// importance (light paths cannot reach it).
+TEST(Camera, OrthographicRaysAreParallelFromTheNearPlane) {
+    Camera c;
+    c.projection = Projection::Orthographic;
+    c.to_world = Transform::look_at(Vec3(1, 2, 3), Vec3(1, 2, 0), Vec3(0, 1, 0)) * Transform::scale(Vec3(2, 2, 1));
+    c.width = 64;
+    c.height = 32;
+    c.near_clip = 0.5f;
+    c.far_clip = 10.f;
+    c.finalize();
+    const Ray centre = c.generate_ray(Vec2(0.5f, 0.5f)), corner = c.generate_ray(Vec2(0.f, 0.f));
+    EXPECT_NEAR(centre.o.x, 1.f, 1e-5f);
+    EXPECT_NEAR(centre.o.y, 2.f, 1e-5f);
+    EXPECT_NEAR(centre.o.z, 2.5f, 1e-5f);  // the near plane, along the view direction -z
+    EXPECT_NEAR(centre.d.z, -1.f, 1e-6f);
+    EXPECT_EQ(centre.tmin, 0.f);
+    EXPECT_NEAR(centre.tmax, 9.5f, 1e-5f);
+    // Film (0,0) is the top-left, camera +x is the image's left: look_at from +z flips x to world -x...
+    // ...so the top-left corner lies at world x = 1 + 2 (camera x = +1, scaled by 2, mirrored by the view).
+    EXPECT_NEAR(std::abs(corner.o.x - 1.f), 2.f, 1e-5f);
+    EXPECT_NEAR(corner.o.y - 2.f, 1.f, 1e-5f);  // y spans [-1/aspect, 1/aspect] = [-0.5, 0.5], times 2
+    EXPECT_EQ(corner.d.x, centre.d.x);
+    EXPECT_EQ(corner.d.z, centre.d.z);
+    EXPECT_FALSE(c.has_importance());
+    EXPECT_FALSE(c.connect(Vec3(1, 2, 0)).valid());
+    EXPECT_EQ(c.importance(centre.d), 0.f);
+
+    Camera cropped = c;
+    cropped.crop(40, 6, 20, 20);
+    cropped.finalize();
+    const Ray a = cropped.pixel_ray(3, 4, Vec2(0.3f, 0.6f)), b = c.pixel_ray(43, 10, Vec2(0.3f, 0.6f));
+    EXPECT_TRUE(a.o.x == b.o.x && a.o.y == b.o.y && a.o.z == b.o.z && a.d.z == b.d.z);
+}
+
+TEST(Camera, BadClipDistancesAreRefused) {
+    Camera c;
+    c.near_clip = 0.f;
+    EXPECT_THROW(c.finalize(), std::invalid_argument);
+    c.near_clip = 2.f;
+    c.far_clip = 1.f;
+    EXPECT_THROW(c.finalize(), std::invalid_argument);
 }

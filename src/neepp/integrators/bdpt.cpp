@@ -51,6 +51,12 @@ BDPTIntegrator::BDPTIntegrator(BDPTOptions options, std::unique_ptr<ShadowRayTes
 }
 
 void BDPTIntegrator::prepare(const Scene &scene) {
+    // Mitsuba 3's ptracer refuses such a sensor too (it has no sample_direction): a light path would meet
+    // an orthographic camera's rays with probability zero.
+    if (!scene.camera.has_importance())
+        throw std::invalid_argument(std::string(options_.light_tracer ? "light" : "bdpt") +
+                                    ": the orthographic sensor cannot be reached by light paths (it has no "
+                                    "importance function); render this scene with the path integrator");
     shadow_->prepare(scene);
     queries_ = &shadow_->query_tester();
     if (options_.neepp_selection && !shadow_->visibility_map())

@@ -13,7 +13,7 @@ namespace neepp {
 
 class Scene;
 class Sampler;
-struct PerspectiveCamera;
+struct Camera;
 
 enum class VertexKind : uint8_t { Camera, Light, Surface };
 
@@ -47,7 +47,7 @@ struct PathVertex {
 // scene's bounding sphere (which infinite lights emit from).
 struct BidirContext {
     const Scene *scene = nullptr;
-    const PerspectiveCamera *camera = nullptr;
+    const Camera *camera = nullptr;
     const LightSampler *lights = nullptr;  // context-free: light subpaths choose their light before any point
     float disk_pdf = 0;                    // 1 / (pi r^2) of the scene's bounding sphere
 };

@@ -65,7 +65,7 @@ float PSSMLTIntegrator::evaluate(const Scene &scene, PrimarySampleSpaceSampler &
                                  RenderCounters &counters) const {
     out.clear();
     sampler.start_evaluation();
-    const PerspectiveCamera &cam = scene.camera;
+    const Camera &cam = scene.camera;
     // The film position, as the render loop draws it: the first two numbers of the camera stream.
     const Vec2 u = sampler.next_2d();
     const Ray ray = cam.generate_ray(u);

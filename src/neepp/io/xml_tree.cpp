@@ -1,6 +1,7 @@
 // Mitsuba 3 XML reader. The rules follow Mitsuba 3.9's src/core/parser.cpp: attribute checks,
 // $parameter substitution, <default>, transform composition, <ref>/<alias>/<include>.
 #include "neepp/io/xml_tree.h"
+#include "neepp/math/spectrum.h"
 
 #include <algorithm>
 #include <charconv>
@@ -26,6 +27,7 @@ const char *kind_name(XmlProperty::Kind kind) {
         case XmlProperty::Kind::Boolean: return "boolean";
         case XmlProperty::Kind::String: return "string";
         case XmlProperty::Kind::RGB: return "rgb";
+        case XmlProperty::Kind::Spectrum: return "spectrum";
         case XmlProperty::Kind::Vector: return "vector";
         case XmlProperty::Kind::Point: return "point";
         case XmlProperty::Kind::Transform: return "transform";
@@ -70,10 +72,15 @@ std::string as_string(const XmlNode &n, const std::string &prop, const XmlProper
     return p.s;
 }
 
-// Mitsuba accepts a plain float wherever a spectrum is expected and treats it as a grey constant.
-Color as_rgb(const XmlNode &n, const std::string &prop, const XmlProperty &p) {
+// Mitsuba accepts a plain float wherever a spectrum is expected and treats it as a grey constant. A
+// <spectrum> becomes RGB as Mitsuba's RGB variants make it: as emission when an emitter reads it.
+Color as_rgb(const XmlNode &n, const std::string &prop, const XmlProperty &p, bool unbounded = false) {
     if (p.kind == Kind::RGB) return p.v;
     if (p.kind == Kind::Float) return Color(float(p.f));
+    if (p.kind == Kind::Spectrum)
+        return spectrum_to_rgb(p.spectrum, n.tag == "emitter" ? SpectrumUse::Emission
+                                           : unbounded        ? SpectrumUse::Unbounded
+                                                              : SpectrumUse::Reflectance);
     wrong_kind(n, prop, p, "rgb, spectrum or float");
 }
 
@@ -122,6 +129,10 @@ Color XmlNode::get_rgb(const std::string &prop) const { return as_rgb(*this, pro
 Color XmlNode::get_rgb(const std::string &prop, const Color &def) const {
     const XmlProperty *p = find(prop, false);
     return p ? as_rgb(*this, prop, *p) : def;
+}
+Color XmlNode::get_unbounded_rgb(const std::string &prop, const Color &def) const {
+    const XmlProperty *p = find(prop, false);
+    return p ? as_rgb(*this, prop, *p, true) : def;
 }
 Vec3 XmlNode::get_vector(const std::string &prop) const { return as_vector(*this, prop, *find(prop, true)); }
 Vec3 XmlNode::get_vector(const std::string &prop, const Vec3 &def) const {
@@ -236,7 +247,16 @@ struct SourceFile {
 class Parser {
 public:
     Parser(const std::map<std::string, std::string> &defines, std::string base_dir) : base_dir_(std::move(base_dir)) {
-        for (const auto &[k, v] : defines) add_param(k, v);
+        for (const auto &[k, v] : defines) add_param(k, v, false);
+    }
+
+    // The -D parameters no attribute substituted, as "name=value".
+    std::vector<std::string> unused_defines() const {
+        std::vector<std::string> out;
+        for (const Param &p : params_)
+            if (!p.used) out.push_back(p.key.substr(1) + "=" + p.value);
+        std::sort(out.begin(), out.end());
+        return out;
     }
 
     std::shared_ptr<XmlNode> parse(const std::string &path) {
@@ -258,6 +278,7 @@ public:
 private:
     struct Param {
         std::string key, value;  // key includes the '$'
+        bool used = true;        // a -D parameter starts unused; a <default> never counts as one
     };
 
     std::vector<Param> params_;  // longest key first, so "$resx2" is not substituted as "$resx" + "2"
@@ -265,8 +286,8 @@ private:
     std::string base_dir_;
     std::shared_ptr<std::vector<std::string>> search_dirs_ = std::make_shared<std::vector<std::string>>();
 
-    void add_param(const std::string &name, const std::string &value) {
-        Param p{"$" + name, value};
+    void add_param(const std::string &name, const std::string &value, bool from_default) {
+        Param p{"$" + name, value, from_default};
         auto pos = std::find_if(params_.begin(), params_.end(), [&](const Param &q) { return p.key.size() > q.key.size(); });
         params_.insert(pos, std::move(p));
     }
@@ -325,13 +346,14 @@ private:
         for (pugi::xml_attribute attr : el.attributes()) {
             std::string value = attr.value();
             if (value.find('$') == std::string::npos) continue;
-            for (const Param &p : params_) {
+            for (Param &p : params_) {
                 for (size_t pos = value.find(p.key); pos != std::string::npos; pos = value.find(p.key, pos)) {
                     if (pos > 0 && value[pos - 1] == '\\') {
                         pos += p.key.size();
                         continue;
                     }
                     value.replace(pos, p.key.size(), p.value);
+                    p.used = true;
                     pos += p.value.size();
                 }
             }
@@ -496,13 +518,16 @@ private:
             else if (tokens.size() == 3) p.v = three_numbers(src, el, "value");
             else fail(src, el, "<rgb> needs one or three values, got " + std::to_string(tokens.size()));
         } else if (tag == "spectrum") {
+            // Kept as a spectrum: whether it is a reflectance or an emission decides its RGB.
             check_attributes(src, el, {"!name", "value", "filename"});
-            p.kind = Kind::RGB;
-            auto tokens = tokenize(el.attribute("value").value());
-            // Wavelength:value pairs and spectrum files need a spectral-to-RGB conversion we lack.
-            if (el.attribute("filename") || tokens.size() != 1 || tokens[0].find(':') != std::string_view::npos)
-                fail(src, el, "only a constant <spectrum value=\"x\"> is supported (use <rgb> instead)");
-            p.v = Vec3(float(number(src, el, tokens[0], "spectrum")));
+            p.kind = Kind::Spectrum;
+            const pugi::xml_attribute value = el.attribute("value"), file = el.attribute("filename");
+            if (bool(value) == bool(file)) fail(src, el, "<spectrum> needs either \"value\" or \"filename\" (not both)");
+            try {
+                p.spectrum = value ? parse_spectrum(value.value()) : read_spectrum_file(parent.resolve_path(file.value()));
+            } catch (const std::exception &e) {
+                fail(src, el, std::string("<spectrum>: ") + e.what());
+            }
         } else if (tag == "vector" || tag == "point") {
             check_attributes(src, el, {"!name", "value", "x", "y", "z"});
             p.kind = tag == "vector" ? Kind::Vector : Kind::Point;
@@ -521,7 +546,7 @@ private:
             check_attributes(src, el, {"!name", "!value"});
             std::string name = el.attribute("name").value();
             if (name.empty()) fail(src, el, "<default> needs a non-empty name");
-            if (!has_param(name)) add_param(name, el.attribute("value").value());
+            if (!has_param(name)) add_param(name, el.attribute("value").value(), true);
             return;
         } else if (tag == "alias") {
             check_attributes(src, el, {"!id", "!as"});
@@ -640,11 +665,25 @@ private:
 
 }  // namespace
 
-std::shared_ptr<XmlNode> parse_mitsuba_xml(const std::string &path, const std::map<std::string, std::string> &defines) {
+std::shared_ptr<XmlNode> parse_mitsuba_xml(const std::string &path, const std::map<std::string, std::string> &defines,
+                                           std::vector<std::string> *unused_defines) {
     // Like Mitsuba's file resolver, relative file names resolve against the top-level scene's folder
     // (also for objects from included files).
     std::string dir = fs::absolute(fs::path(path)).parent_path().lexically_normal().string();
-    return Parser(defines, dir).parse(path);
+    Parser parser(defines, dir);
+    std::shared_ptr<XmlNode> root = parser.parse(path);
+    std::vector<std::string> unused = parser.unused_defines();
+    if (unused_defines) *unused_defines = std::move(unused);
+    else if (!unused.empty()) throw SceneError(path, unused_parameters_problem(unused));
+    return root;
+}
+
+std::string unused_parameters_problem(const std::vector<std::string> &unused) {
+    std::string list;
+    for (const std::string &u : unused) list += (list.empty() ? "-D " : ", -D ") + u;
+    return std::string("unused parameter") + (unused.size() == 1 ? "" : "s") + " " + list +
+           ": the scene substitutes no such $name (a misspelt -D would otherwise be ignored; Mitsuba 3 refuses "
+           "it too)";
 }
 
 }  // namespace neepp

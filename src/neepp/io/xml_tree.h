@@ -7,14 +7,15 @@
 #include <string>
 #include <vector>
 #include "neepp/io/scene_error.h"
+#include "neepp/math/spectrum.h"
 #include "neepp/math/transform.h"
 
 namespace neepp {
 
 struct XmlProperty {
-    // <spectrum value="x"> (a constant) is stored as RGB: the renderer works in RGB, like Mitsuba's
-    // *_rgb variants.
-    enum class Kind { Integer, Float, Boolean, String, RGB, Vector, Point, Transform };
+    // A <spectrum> is kept as one (Spectrum): the getters turn it into RGB, as Mitsuba's *_rgb variants
+    // do, as a reflectance or, read by an emitter, as an emission.
+    enum class Kind { Integer, Float, Boolean, String, RGB, Spectrum, Vector, Point, Transform };
     Kind kind = Kind::String;
     int64_t i = 0;
     double f = 0;
@@ -22,6 +23,7 @@ struct XmlProperty {
     std::string s;
     Vec3 v;  // RGB, Vector and Point
     Transform xf;
+    Spectrum spectrum;
     int line = 0;
     mutable bool used = false;  // set by XmlNode's getters, so unread properties can be reported
 };
@@ -59,8 +61,12 @@ struct XmlNode {
     bool get_bool(const std::string &prop, bool def) const;
     std::string get_string(const std::string &prop) const;
     std::string get_string(const std::string &prop, const std::string &def) const;
-    Color get_rgb(const std::string &prop) const;  // rgb, constant spectrum, or float (grey)
+    // rgb, spectrum, or float (grey); a spectrum as a reflectance (within [0, 1]), or as an emission on
+    // an <emitter>.
+    Color get_rgb(const std::string &prop) const;
     Color get_rgb(const std::string &prop, const Color &def) const;
+    // The same for a property Mitsuba reads unbounded (a conductor's eta and k): a spectrum only kept >= 0.
+    Color get_unbounded_rgb(const std::string &prop, const Color &def) const;
     Vec3 get_vector(const std::string &prop) const;  // <vector> or <point>
     Vec3 get_vector(const std::string &prop, const Vec3 &def) const;
     Transform get_transform(const std::string &prop, const Transform &def = Transform()) const;
@@ -83,8 +89,13 @@ private:
 };
 
 // Parses a Mitsuba 3 scene file. `defines` are the -D name=value parameters; they take precedence
-// over the file's <default> values. Throws SceneError (file:line: problem) on any error.
+// over the file's <default> values. Throws SceneError (file:line: problem) on any error. A define that
+// no attribute substitutes is refused as Mitsuba 3 refuses it; when `unused_defines` is given, such
+// defines ("name=value") are put there instead, for the caller to judge.
 std::shared_ptr<XmlNode> parse_mitsuba_xml(const std::string &path,
-                                           const std::map<std::string, std::string> &defines = {});
+                                           const std::map<std::string, std::string> &defines = {},
+                                           std::vector<std::string> *unused_defines = nullptr);
+// The problem text for unused defines ("name=value" each).
+std::string unused_parameters_problem(const std::vector<std::string> &unused);
 
 }  // namespace neepp

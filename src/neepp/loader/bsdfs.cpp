@@ -33,7 +33,7 @@ std::pair<TexturePtr, TexturePtr> conductor_ior(Factories &f, const XmlNode &nod
     std::string material = node.get_string("material", "none");
     if (node.has("eta") || node.child("eta")) {
         if (material != "none") throw node.error("give either 'material' or 'eta'/'k', not both");
-        return {f.texture_param(node, "eta", Color(0.f)), f.texture_param(node, "k", Color(1.f))};
+        return {f.texture_param(node, "eta", Color(0.f), true), f.texture_param(node, "k", Color(1.f), true)};
     }
     auto ior = lookup_conductor_ior(material);
     if (!ior) throw node.error("unknown conductor material '" + material + "'");
@@ -90,7 +90,7 @@ PrincipledThinParams Factories::principled_thin_params(const XmlNode &node) {
     PrincipledThinParams p;
     p.base_color = texture_param(node, "base_color", Color(0.5f));
     p.roughness = texture_param(node, "roughness", Color(0.5f));
-    p.eta = texture_param(node, "eta", Color(1.5f));
+    p.eta = texture_param(node, "eta", Color(1.5f), true);
     p.anisotropic = principled_lobe_param(node, "anisotropic");
     p.spec_trans = principled_lobe_param(node, "spec_trans");
     p.spec_tint = principled_lobe_param(node, "spec_tint");
@@ -196,10 +196,10 @@ BSDFPtr Factories::create_bsdf(const XmlNode &node) {
         TexturePtr au, av;
         if (node.has("alpha_u") || node.child("alpha_u")) {
             if (node.has("alpha") || node.child("alpha")) throw node.error("give either 'alpha' or 'alpha_u'/'alpha_v'");
-            au = texture_param(node, "alpha_u", Color(0.1f));
-            av = texture_param(node, "alpha_v", Color(0.1f));
+            au = texture_param(node, "alpha_u", Color(0.1f), true);
+            av = texture_param(node, "alpha_v", Color(0.1f), true);
         } else {
-            au = av = texture_param(node, "alpha", Color(0.1f));
+            au = av = texture_param(node, "alpha", Color(0.1f), true);
         }
         b = std::make_shared<RoughConductorBSDF>(distribution_param(node), au, av, eta, k,
                                                  texture_param_or_null(node, "specular_reflectance"),
@@ -227,10 +227,10 @@ BSDFPtr Factories::create_bsdf(const XmlNode &node) {
         if (has_u || has_v) {
             if (!has_u || !has_v) throw node.error("give both 'alpha_u' and 'alpha_v'");
             if (node.has("alpha") || node.child("alpha")) throw node.error("give either 'alpha' or 'alpha_u'/'alpha_v'");
-            au = texture_param(node, "alpha_u", Color(0.1f));
-            av = texture_param(node, "alpha_v", Color(0.1f));
+            au = texture_param(node, "alpha_u", Color(0.1f), true);
+            av = texture_param(node, "alpha_v", Color(0.1f), true);
         } else {
-            au = av = texture_param(node, "alpha", Color(0.1f));
+            au = av = texture_param(node, "alpha", Color(0.1f), true);
         }
         const float int_ior = ior_param(node, "int_ior", 1.5046f), ext_ior = ior_param(node, "ext_ior", 1.000277f);
         if (int_ior == ext_ior) throw node.error("'int_ior' and 'ext_ior' must differ");

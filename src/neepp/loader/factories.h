@@ -15,8 +15,9 @@ class Factories {
 public:
     TexturePtr texture(const XmlNode &node);
     // The parameter `name` of node as a texture: a nested texture, an rgb/float/spectrum constant, or def.
-    TexturePtr texture_param(const XmlNode &node, const std::string &name, Color def);
-    TexturePtr texture_param_or_null(const XmlNode &node, const std::string &name);
+    // unbounded: a spectrum is not clamped to [0, 1] (Mitsuba's get_unbounded_texture, e.g. a conductor's eta).
+    TexturePtr texture_param(const XmlNode &node, const std::string &name, Color def, bool unbounded = false);
+    TexturePtr texture_param_or_null(const XmlNode &node, const std::string &name, bool unbounded = false);
     BSDFPtr bsdf(const XmlNode &node);
     BSDFPtr default_bsdf();
     BSDFPtr black_bsdf();  // an emitter's default
@@ -51,6 +52,9 @@ void load_integrator(const XmlNode &node, RenderSettings &settings);
 void transform_shape(Shape &s, const Transform &to_world);
 // Reports properties that no builder read (misspelt or unsupported) on stderr, as Mitsuba does.
 void warn_unused(const XmlNode &node);
+// A perspective projection's angle of view (a perspective sensor's, a projector's): fov along fov_axis,
+// or Mitsuba 3's default from focal_length.
+void load_fov(const XmlNode &node, Camera &cam);
 // An IOR given as a number or a name from Mitsuba's table ("bk7", "air"...).
 float ior_param(const XmlNode &node, const std::string &name, float def);
 

@@ -10,6 +10,30 @@
 #include "neepp/loader/problems.h"
 
 namespace neepp {
+
+namespace loader {
+
+void load_fov(const XmlNode &sensor, Camera &cam) {
+    if (sensor.has("fov")) {
+        cam.fov = sensor.get_float("fov");
+        cam.fov_axis = sensor.get_string("fov_axis", "x");
+        return;
+    }
+    // fov_axis is then left unread, as Mitsuba does (it refuses the scene, neepp warns).
+    // Mitsuba 3's default: a focal length (35 mm film equivalent, 50mm unless given), which sets the
+    // angle across the 36 x 24 mm frame's diagonal, applied to the film's diagonal whatever fov_axis
+    // says (a square film gets 34.0° in x, a 3:2 one 39.6°).
+    const std::string text = sensor.get_string("focal_length", "50mm");
+    char *end = nullptr;
+    const float f = std::strtof(text.c_str(), &end);
+    if (end == text.c_str() || !(std::string(end).empty() || std::string(end) == "mm") || !(f > 0) || !std::isfinite(f))
+        throw sensor.error("focal_length '" + text + "' is not a length in millimetres (e.g. 50mm)");
+    cam.fov = 2.f * std::atan(std::sqrt(36.f * 36.f + 24.f * 24.f) / (2.f * f)) * 180.f / kPi;
+    cam.fov_axis = "diagonal";
+}
+
+}  // namespace loader
+
 namespace {
 
 void load_film(const XmlNode &film, Scene &scene) {
@@ -54,24 +78,12 @@ void load_film(const XmlNode &film, Scene &scene) {
 }
 
 void load_sensor(const XmlNode &sensor, Scene &scene) {
-    if (sensor.type != "perspective") throw sensor.error("unsupported sensor '" + sensor.type + "' (supported: " + supported_list("sensor") + ")");
-    PerspectiveCamera &cam = scene.camera;
+    if (sensor.type != "perspective" && sensor.type != "orthographic")
+        throw sensor.error("unsupported sensor '" + sensor.type + "' (supported: " + supported_list("sensor") + ")");
+    Camera &cam = scene.camera;
     cam.to_world = sensor.get_transform("to_world");
-    if (sensor.has("fov")) {
-        cam.fov = sensor.get_float("fov");
-        cam.fov_axis = sensor.get_string("fov_axis", "x");
-    } else {  // fov_axis is then left unread, as Mitsuba does (it refuses the scene, neepp warns)
-        // Mitsuba 3's default: a focal length (35 mm film equivalent, 50mm unless given), which sets the
-        // angle across the 36 x 24 mm frame's diagonal, applied to the film's diagonal whatever fov_axis
-        // says (a square film gets 34.0° in x, a 3:2 one 39.6°).
-        const std::string text = sensor.get_string("focal_length", "50mm");
-        char *end = nullptr;
-        const float f = std::strtof(text.c_str(), &end);
-        if (end == text.c_str() || !(std::string(end).empty() || std::string(end) == "mm") || !(f > 0) || !std::isfinite(f))
-            throw sensor.error("focal_length '" + text + "' is not a length in millimetres (e.g. 50mm)");
-        cam.fov = 2.f * std::atan(std::sqrt(36.f * 36.f + 24.f * 24.f) / (2.f * f)) * 180.f / kPi;
-        cam.fov_axis = "diagonal";
-    }
+    if (sensor.type == "perspective") loader::load_fov(sensor, cam);
+    else cam.projection = Projection::Orthographic;
     cam.near_clip = sensor.get_float("near_clip", 1e-2f);
     cam.far_clip = sensor.get_float("far_clip", 1e4f);
     for (const auto &child : sensor.children) {
@@ -96,9 +108,13 @@ void load_sensor(const XmlNode &sensor, Scene &scene) {
 }
 
 
-std::unique_ptr<Scene> read_scene(const std::string &path, const std::map<std::string, std::string> &defines) {
+std::unique_ptr<Scene> read_scene(const std::string &path, const std::map<std::string, std::string> &defines,
+                                  const std::set<std::string> &may_be_unused) {
     using loader::attempt;
-    std::shared_ptr<XmlNode> root = parse_mitsuba_xml(path, defines);
+    std::vector<std::string> unused;
+    std::shared_ptr<XmlNode> root = parse_mitsuba_xml(path, defines, &unused);
+    std::erase_if(unused, [&](const std::string &u) { return may_be_unused.count(u.substr(0, u.find('='))) != 0; });
+    if (!unused.empty()) attempt([&] { throw SceneError(path, unused_parameters_problem(unused)); });
     auto scene = std::make_unique<Scene>();
     scene->source_path = path;
     loader::Factories factories;
@@ -145,8 +161,9 @@ std::unique_ptr<Scene> read_scene(const std::string &path, const std::map<std::s
 
 }  // namespace
 
-std::unique_ptr<Scene> load_scene(const std::string &path, const std::map<std::string, std::string> &defines) {
-    auto scene = read_scene(path, defines);
+std::unique_ptr<Scene> load_scene(const std::string &path, const std::map<std::string, std::string> &defines,
+                                  const std::set<std::string> &may_be_unused) {
+    auto scene = read_scene(path, defines, may_be_unused);
     try {
         scene->build();
     } catch (const std::exception &e) {
@@ -155,11 +172,12 @@ std::unique_ptr<Scene> load_scene(const std::string &path, const std::map<std::s
     return scene;
 }
 
-std::vector<SceneProblem> check_scene(const std::string &path, const std::map<std::string, std::string> &defines) {
+std::vector<SceneProblem> check_scene(const std::string &path, const std::map<std::string, std::string> &defines,
+                                     const std::set<std::string> &may_be_unused) {
     std::vector<SceneProblem> problems;
     loader::CheckingScope scope(problems);
     try {
-        read_scene(path, defines);  // the BVH is not built: it cannot fail where loading succeeded
+        read_scene(path, defines, may_be_unused);  // the BVH is not built: it cannot fail where loading succeeded
     } catch (const SceneError &e) {  // what stops even a check (a malformed XML file)
         loader::record(e);
     }

@@ -7,10 +7,12 @@
 #include "neepp/lights/area_light.h"
 #include "neepp/lights/environment_light.h"
 #include "neepp/lights/directional_light.h"
+#include "neepp/lights/projector_light.h"
 #include "neepp/lights/spot_light.h"
 #include "neepp/math/frame.h"
 #include "neepp/loader/factories.h"
 #include "neepp/loader/problems.h"
+#include "neepp/materials/bitmap_texture.h"
 
 namespace neepp::loader {
 namespace {
@@ -318,6 +320,23 @@ void Factories::emitter(const XmlNode &node, Scene &scene) {
         try {
             scene.add_light(std::make_unique<SpotLight>(node.get_transform("to_world"), node.get_rgb("intensity", Color(1.f)),
                                                         cutoff, beam));
+        } catch (const std::invalid_argument &e) {
+            throw node.error(e.what());
+        }
+    } else if (t == "projector") {
+        // The texture's resolution sets the projection's aspect ratio, as Mitsuba's (1 x 1 unless a bitmap).
+        TexturePtr irradiance = texture_param(node, "irradiance", Color(1.f));
+        Camera frame;
+        frame.to_world = node.get_transform("to_world");
+        load_fov(node, frame);
+        if (auto *bitmap = dynamic_cast<const BitmapTexture *>(irradiance.get())) {
+            frame.width = bitmap->width();
+            frame.height = bitmap->height();
+        } else {
+            frame.width = frame.height = 1;
+        }
+        try {
+            scene.add_light(std::make_unique<ProjectorLight>(frame, irradiance, node.get_float("scale", 1.f)));
         } catch (const std::invalid_argument &e) {
             throw node.error(e.what());
         }

@@ -44,14 +44,14 @@ TexturePtr Factories::texture(const XmlNode &node) {
     return tex;
 }
 
-TexturePtr Factories::texture_param_or_null(const XmlNode &node, const std::string &name) {
+TexturePtr Factories::texture_param_or_null(const XmlNode &node, const std::string &name, bool unbounded) {
     if (auto child = node.child(name)) return texture(*child);
-    if (node.has(name)) return constant_texture(node.get_rgb(name));
+    if (node.has(name)) return constant_texture(unbounded ? node.get_unbounded_rgb(name, Color(0.f)) : node.get_rgb(name));
     return nullptr;
 }
 
-TexturePtr Factories::texture_param(const XmlNode &node, const std::string &name, Color def) {
-    if (TexturePtr t = texture_param_or_null(node, name)) return t;
+TexturePtr Factories::texture_param(const XmlNode &node, const std::string &name, Color def, bool unbounded) {
+    if (TexturePtr t = texture_param_or_null(node, name, unbounded)) return t;
     return constant_texture(def);
 }
 

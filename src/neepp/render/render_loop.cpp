@@ -88,7 +88,7 @@ Image combine_layers(const ImageBlock &samples, const SplatFilm *splats, double 
 }  // namespace
 
 RenderResult render(const Scene &scene, Integrator &integrator, const RenderJob &job) {
-    const PerspectiveCamera &cam = scene.camera;
+    const Camera &cam = scene.camera;
     const int W = cam.width, H = cam.height;
     const bool timed = job.time_limit_s > 0;
     if (job.spp <= 0 && !timed) throw std::invalid_argument("render: give a sample count or a time limit");

@@ -1,16 +1,20 @@
 #include "neepp/scene/camera.h"
 
+#include <cmath>
 #include <stdexcept>
 
 namespace neepp {
 
-void PerspectiveCamera::finalize() {
+void Camera::finalize() {
     if (width <= 0 || height <= 0) throw std::invalid_argument("film size must be positive");
-    if (!(fov > 0 && fov < 180)) throw std::invalid_argument("fov must be in (0, 180) degrees");
+    const bool ortho = projection == Projection::Orthographic;
+    if (!ortho && !(fov > 0 && fov < 180)) throw std::invalid_argument("fov must be in (0, 180) degrees");
+    if (!(near_clip > 0)) throw std::invalid_argument("near_clip must be greater than zero");
+    if (!(near_clip < far_clip)) throw std::invalid_argument("near_clip must be smaller than far_clip");
     const int fw = film_width > 0 ? film_width : width, fh = film_width > 0 ? film_height : height;
-    float t = std::tan(0.5f * fov * kPi / 180.f);
+    float t = ortho ? 1.f : std::tan(0.5f * fov * kPi / 180.f);
     float w = float(fw), h = float(fh), aspect = w / h;
-    std::string axis = fov_axis;
+    std::string axis = ortho ? "x" : fov_axis;  // the orthographic view spans [-1, 1] in x
     if (axis == "smaller") axis = fw <= fh ? "x" : "y";
     else if (axis == "larger") axis = fw >= fh ? "x" : "y";
     if (axis == "x") { tan_x_ = t; tan_y_ = t / aspect; }
@@ -32,7 +36,7 @@ void PerspectiveCamera::finalize() {
     axis_z_ = to_world.vector(Vec3(0, 0, 1));
 }
 
-void PerspectiveCamera::crop(int x, int y, int w, int h) {
+void Camera::crop(int x, int y, int w, int h) {
     const int fw = film_width > 0 ? film_width : width, fh = film_width > 0 ? film_height : height;
     const int fx = film_width > 0 ? crop_x : 0, fy = film_width > 0 ? crop_y : 0;
     if (x < 0 || y < 0 || w < 1 || h < 1 || x > width - w || y > height - h)
@@ -47,17 +51,22 @@ void PerspectiveCamera::crop(int x, int y, int w, int h) {
     height = h;
 }
 
-Ray PerspectiveCamera::generate_ray(Vec2 film) const {
+Ray Camera::generate_ray(Vec2 film) const {
     return film_ray(image_offset_ + Vec2(film.x * image_scale_.x, film.y * image_scale_.y));
 }
 
-Ray PerspectiveCamera::pixel_ray(int x, int y, Vec2 jitter) const {
+Ray Camera::pixel_ray(int x, int y, Vec2 jitter) const {
     const int fw = film_width > 0 ? film_width : width, fh = film_width > 0 ? film_height : height;
     return film_ray({(float(x + crop_x) + jitter.x) / float(fw), (float(y + crop_y) + jitter.y) / float(fh)});
 }
 
-Ray PerspectiveCamera::film_ray(Vec2 film) const {
+Ray Camera::film_ray(Vec2 film) const {
     float x = (1.f - 2.f * film.x) * tan_x_, y = (1.f - 2.f * film.y) * tan_y_;
+    if (projection == Projection::Orthographic) {
+        // As Mitsuba: from the near plane, in world units along the ray (a to_world scale of z scales where
+        // the near plane is, not how far the ray goes).
+        return Ray{to_world.point(Vec3(x, y, near_clip)), normalize(axis_z_), 0.f, far_clip - near_clip};
+    }
     Vec3 d_cam(x, y, 1.f);
     Vec3 d = axis_x_ * d_cam.x + axis_y_ * d_cam.y + axis_z_ * d_cam.z;
     float len = norm(d);
@@ -67,14 +76,15 @@ Ray PerspectiveCamera::film_ray(Vec2 film) const {
     return Ray{origin_, d, near_clip * inv_z, far_clip * inv_z};
 }
 
-bool PerspectiveCamera::film_of(const Vec3 &local, Vec2 &film) const {
+bool Camera::film_of(const Vec3 &local, Vec2 &film) const {
     if (!(local.z > 0)) return false;
     film = Vec2(0.5f * (1.f - local.x / (local.z * tan_x_)), 0.5f * (1.f - local.y / (local.z * tan_y_)));
     film = Vec2((film.x - image_offset_.x) / image_scale_.x, (film.y - image_offset_.y) / image_scale_.y);  // -> image
     return film.x >= 0.f && film.x < 1.f && film.y >= 0.f && film.y < 1.f;
 }
 
-float PerspectiveCamera::importance(const Vec3 &w) const {
+float Camera::importance(const Vec3 &w) const {
+    if (!has_importance()) return 0.f;
     const Vec3 local = normalize(to_world.inverse_vector(w));
     Vec2 film;
     if (!film_of(local, film)) return 0.f;
@@ -82,15 +92,17 @@ float PerspectiveCamera::importance(const Vec3 &w) const {
     return inv_plane_area_ / (c2 * c2);
 }
 
-float PerspectiveCamera::pdf_direction(const Vec3 &w) const {
+float Camera::pdf_direction(const Vec3 &w) const {
+    if (!has_importance()) return 0.f;
     const Vec3 local = normalize(to_world.inverse_vector(w));
     Vec2 film;
     if (!film_of(local, film)) return 0.f;
     return inv_plane_area_ / (local.z * local.z * local.z);
 }
 
-CameraConnection PerspectiveCamera::connect(const Vec3 &ref) const {
+CameraConnection Camera::connect(const Vec3 &ref) const {
     CameraConnection c;
+    if (!has_importance()) return c;
     const Vec3 local = to_world.inverse().point(ref);
     Vec2 film;
     if (!film_of(local, film) || local.z < near_clip || local.z > far_clip) return c;

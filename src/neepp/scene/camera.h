@@ -1,5 +1,6 @@
-// Pinhole perspective camera with Mitsuba 3's conventions: camera space looks down +z with +y up and +x
-// toward the left of the image; film coordinates run from (0,0) at the top-left to (1,1) bottom-right.
+// The camera, Mitsuba 3's `perspective` (a pinhole) or `orthographic` sensor, with its conventions: camera
+// space looks down +z with +y up and +x toward the left of the image; film coordinates run from (0,0) at
+// the top-left to (1,1) bottom-right.
 #pragma once
 #include <string>
 #include "neepp/math/transform.h"
@@ -18,10 +19,19 @@ struct CameraConnection {
     bool valid() const { return weight > 0; }
 };
 
-struct PerspectiveCamera {
+enum class Projection : uint8_t {
+    Perspective,
+    // Parallel rays along camera +z from the near plane, over camera-space x in [-1, 1] and y in
+    // [-1/aspect, 1/aspect] (so a to_world scale sets the view's extent). It has no importance function,
+    // as Mitsuba's has none: light paths cannot connect to it (bdpt and light tracing refuse it).
+    Orthographic,
+};
+
+struct Camera {
+    Projection projection = Projection::Perspective;
     Transform to_world;
     int width = 768, height = 576;
-    float fov = 39.3077f;          // degrees, along fov_axis (the loader sets Mitsuba 3's default when a scene gives none)
+    float fov = 39.3077f;          // perspective only: degrees, along fov_axis (the loader sets Mitsuba 3's default when a scene gives none)
     std::string fov_axis = "x";    // x, y, diagonal, smaller, larger
     float near_clip = 1e-2f, far_clip = 1e4f;
     // A crop window (Mitsuba's hdrfilm crop_offset_x/y, crop_width/height; the CLI's --crop): the image is
@@ -41,7 +51,9 @@ struct PerspectiveCamera {
     Ray pixel_ray(int x, int y, Vec2 jitter) const;
     Vec3 position() const { return to_world.point(Vec3(0.f)); }
 
-    // The camera's importance, for paths traced from the lights. We is normalized as pbrt's is: over the
+    // Whether light paths can reach the camera (connect() and importance() mean something).
+    bool has_importance() const { return projection == Projection::Perspective; }
+    // The camera's importance, for paths traced from the lights (perspective only: zero otherwise). We is normalized as pbrt's is: over the
     // image plane at distance 1 (area A = 4 tan_x tan_y), We = 1 / (A cos^4 theta) inside the film, so
     // that a camera ray's We · cos / pdf is 1 (pdf_direction is 1 / (A cos^3 theta)) and a light path
     // splatted with connect()'s weight, into one pixel of W·H, estimates radiance when the splats of
@@ -52,10 +64,11 @@ struct PerspectiveCamera {
     CameraConnection connect(const Vec3 &ref) const;
 
 private:
-    // Camera-space direction (not normalized) of world direction w, and the film position it meets (false
-    // outside the film or behind the camera).
+    // The film position that camera-space direction `local` (not normalized) meets (false outside the film
+    // or behind the camera).
     bool film_of(const Vec3 &local, Vec2 &film) const;
     Ray film_ray(Vec2 film) const;  // through film position (whole film, [0,1)^2)
+    // Half the film's extent on the plane at distance 1 (perspective) or on the near plane (orthographic).
     float tan_x_ = 0, tan_y_ = 0, inv_plane_area_ = 0;
     Vec2 image_scale_{1.f, 1.f}, image_offset_{0.f, 0.f};  // the image's window in film coordinates
     Vec3 origin_, axis_x_, axis_y_, axis_z_;

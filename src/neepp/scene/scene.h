@@ -83,7 +83,7 @@ public:
     const BBox &bounds() const { return bounds_; }
     size_t triangle_count() const;
 
-    PerspectiveCamera camera;
+    Camera camera;
     RenderSettings settings;
     std::string source_path;  // scene file it came from, for messages and statistics
 
