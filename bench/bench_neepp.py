@@ -1,12 +1,15 @@
 #!/usr/bin/env python3
-"""Reproduce the NEE++ paper's tables: `nee` against each NEE++ shadow-ray policy of the path integrator.
+"""Reproduce the NEE++ paper's tables: `nee` against each NEE++ shadow-ray policy of the path integrator,
+and against NEE++'s map used inside an environment light (configurations env-visibility, env-visibility-fitted).
 
 For every scene, at each sample count (default 4, 64, 1024) every policy renders the same scene with the
 same seed; the tables give, with ratios to `nee`: relMSE against the reference, shadow rays traced,
 time inside occlusion queries (visibility-test time) and total render time. An equal-time block then
 gives each policy the wall time `nee` needed at the middle sample count and compares relMSE, and, from
-a second render with another seed, relVar: the variance alone, free of the reference's floor. For `nee`
-the unoccluded fraction of its shadow rays (the oracle's best possible ratio) is reported too.
+a second render with another seed, relVar: the variance alone, free of the reference's floor. The
+equal-spp tables get the same second render (unless --no-variance) and with it the efficiency,
+1 / (relVar x time), relative to `nee`'s: what issue 28 measures. For `nee` the unoccluded fraction of
+its shadow rays (the oracle's best possible ratio) is reported too.
 
 Resolution: the reference's divided by --scale (default 4, e.g. 160x90 for classroom), rendered with a
 box filter and compared against the Mitsuba 3 reference box-downsampled by the same factor, so the
@@ -30,11 +33,23 @@ sys.path.insert(0, str(REPO / "python"))
 
 from neepp_tools import REFERENCES, SCENES_DIR, credit, exr, machine, metrics, report, runner  # noqa: E402
 
-POLICIES = ["nee", "neepp", "neepp-adaptive", "neepp-cv"]
+POLICIES = ["nee", "neepp", "neepp-adaptive", "neepp-cv", "env-visibility"]
+# Configurations beyond a shadow-ray policy's name (any other name is passed as shadow_rays=NAME): NEE++'s
+# visibility map used inside an environment light (within_light), over the scene's grid or one fitted to
+# where the camera's paths shade.
+CONFIGS = {
+    "nee": {},
+    "env-visibility": {"within_light": "visibility"},
+    "env-visibility-fitted": {"within_light": "visibility", "grid_bounds": "shading"},
+}
+
+
+def config_options(policy: str) -> dict:
+    return dict(CONFIGS.get(policy, {"shadow_rays": policy}))
 
 
 def render(scene_xml, out, policy, *, spp=None, time_s=None, w, h, max_depth, seed, threads, options):
-    args = {"shadow_rays": policy, **options} if policy != "nee" else dict(options)
+    args = {**config_options(policy), **options}
     return runner.run_neepp(scene_xml, out, spp=spp, time_s=time_s, resx=w, resy=h, max_depth=max_depth,
                             seed=seed, threads=threads, integrator_args=args, extra_args=["--rfilter", "box"],
                             timeout=7200)
@@ -54,6 +69,22 @@ def row_for(policy, r, ref, base):
         traced = max(1, s["shadow_rays"])
         row["unoccluded fraction"] = 1 - s.get("shadow_rays_occluded", 0) / traced
     return row
+
+
+def add_variance(rows, images, render_again, ref):
+    """relVar from a second render with another seed (free of the reference's floor), and efficiency
+    1 / (relVar x render time) relative to the first row's (`nee`)."""
+    base = None
+    for row in rows:
+        again = render_again(row["policy"])
+        row["relVar"] = metrics.relative_variance(images[row["policy"]], again.image, ref)
+        cost = row["relVar"] * row["render_s"]
+        base = base or cost
+        if base is not cost:
+            row["relVar ratio"] = row["relVar"] / rows[0]["relVar"]
+            # No sample in the budget (seeding took it all): nothing was bought.
+            row["efficiency"] = base / cost if cost > 0 and row["spp"] > 0 else 0.0
+        print(json.dumps(row), flush=True)
 
 
 def run_policies(policies, name, ref, render_one):
@@ -79,7 +110,10 @@ def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--scenes", default=",".join(REFERENCES))
     ap.add_argument("--spp", default="4,64,1024", help="comma-separated sample counts")
-    ap.add_argument("--policies", default=",".join(POLICIES))
+    ap.add_argument("--policies", default=",".join(POLICIES),
+                    help="shadow-ray policies, or configurations: " + ", ".join(CONFIGS))
+    ap.add_argument("--variance", action=argparse.BooleanOptionalAction, default=True,
+                    help="render every equal-spp configuration twice (another seed) for relVar and efficiency")
     ap.add_argument("--scale", type=int, default=4, help="divide the reference resolution by this")
     ap.add_argument("--equal-time-spp", type=int, default=0,
                     help="equal-time budget = nee's time at this sample count (one of --spp; default the middle "
@@ -112,6 +146,10 @@ def main(argv=None) -> int:
             rows, images = run_policies(policies, f"{spp}spp", ref, lambda policy, name: render(
                 xml, out / scene / name, policy, spp=spp, w=w, h=h, max_depth=a.max_depth, seed=a.seed,
                 threads=a.threads, options=options))
+            if a.variance:
+                add_variance(rows, images, lambda policy: render(
+                    xml, out / scene / f"{policy}_{spp}spp_seed2.exr", policy, spp=spp, w=w, h=h,
+                    max_depth=a.max_depth, seed=a.seed + 1000, threads=a.threads, options=options), ref)
             results[scene]["equal_spp"][spp] = rows
             md.append(f"\n### equal spp: {spp}\n\n" + table(rows) + "\n")
             report.comparison_figure(out / scene / f"compare_{spp}spp.png", images, ref=ref,
@@ -125,17 +163,9 @@ def main(argv=None) -> int:
         # The same again with another seed: the pair's difference measures each policy's variance without
         # the reference's floor (at high spp relMSE against the reference is mostly that floor, which
         # pulls every ratio toward 1).
-        base_var = None
-        for row in rows:
-            policy = row["policy"]
-            again = render(xml, out / scene / f"{policy}_equal_time_seed2.exr", policy, time_s=budget, w=w, h=h,
-                           max_depth=a.max_depth, seed=a.seed + 1000, threads=a.threads, options=options)
-            row["relVar"] = metrics.relative_variance(equal_time_images[policy], again.image, ref)
-            row["spp (seed 2)"] = again.stats["spp"]
-            base_var = base_var or row["relVar"]
-            if policy != "nee":
-                row["relVar ratio"] = row["relVar"] / base_var
-            print(json.dumps(row), flush=True)
+        add_variance(rows, equal_time_images, lambda policy: render(
+            xml, out / scene / f"{policy}_equal_time_seed2.exr", policy, time_s=budget, w=w, h=h,
+            max_depth=a.max_depth, seed=a.seed + 1000, threads=a.threads, options=options), ref)
         results[scene]["equal_time"] = {"budget_s": budget, "rows": rows}
         md.append(f"\n### equal time: {budget:.2f} s (nee's time at {mid} spp)\n\n" + table(rows) + "\n")
         (out / "results.json").write_text(json.dumps(results, indent=2))
