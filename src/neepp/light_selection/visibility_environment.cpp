@@ -25,8 +25,8 @@ VisibilityEnvironmentSampler::VisibilityEnvironmentSampler(const EnvironmentMapL
     const AliasTable &cells = env.sampling_cells();
     const uint32_t n = uint32_t(w) * uint32_t(h);
     groups_.resize(kGroups);
-    group_of_cell_.resize(n);
-    local_index_.resize(n);
+    cells_.resize(n);
+    std::vector<uint32_t> local(n);
     std::vector<std::vector<float>> weights(kGroups);
     for (uint32_t c = 0; c < n; ++c) {
         // A cell belongs to the bin its centre points into; the density stays exact whatever the
@@ -34,11 +34,11 @@ VisibilityEnvironmentSampler::VisibilityEnvironmentSampler(const EnvironmentMapL
         const Vec2 centre((float(c % uint32_t(w)) + 0.5f) / float(w), (float(c / uint32_t(w)) + 0.5f) / float(h));
         const Vec3 d = env.uv_to_direction(centre);
         const uint32_t g = grid.cell_of_direction(d) - grid.voxel_count();
-        group_of_cell_[c] = uint16_t(g);
+        cells_[c].group = g;
         const float p = cells.pmf(c);
         if (!(p > 0)) continue;  // never sampled by the map itself: never by a group either
         Group &group = groups_[g];
-        local_index_[c] = uint32_t(group.cells.size());
+        local[c] = uint32_t(group.cells.size());
         group.cells.push_back(c);
         weights[g].push_back(p);
         group.mass += p;
@@ -49,6 +49,7 @@ VisibilityEnvironmentSampler::VisibilityEnvironmentSampler(const EnvironmentMapL
         Group &group = groups_[g];
         if (weights[g].empty()) continue;
         group.table = AliasTable(weights[g]);
+        for (const uint32_t c : group.cells) cells_[c].pmf = group.table.pmf(local[c]);
         for (uint32_t b = 0; b < kNoOrientation; ++b) group.facing[b] = float(group.facing[b] / group.mass);
         group.facing[kNoOrientation] = 1.f;
     }
@@ -116,13 +117,10 @@ DirectionSample VisibilityEnvironmentSampler::finish(const LightSampleContext &c
 
 float VisibilityEnvironmentSampler::pdf(const LightSampleContext &ctx, const DirectionSample &ds) const {
     const Vec2 uv = env_.direction_to_uv(ds.d);
-    const uint32_t cell = env_.sampling_cell(uv);
-    const Group &group = groups_[group_of_cell_[cell]];
-    if (group.cells.empty() || group.cells[local_index_[cell]] != cell) return 0.f;  // a cell the map never samples
-    const float pmf = group.table.pmf(local_index_[cell]);
+    const CellInfo cell = cells_[env_.sampling_cell(uv)];
+    if (!(cell.pmf > 0)) return 0.f;  // a cell the map never samples
     const int w = env_.sampling_width(), h = env_.sampling_height();
-    return EnvironmentMapLight::solid_angle_density(
-        uv, table(ctx).pmf(group_of_cell_[cell]) * pmf * float(w) * float(h));
+    return EnvironmentMapLight::solid_angle_density(uv, table(ctx).pmf(cell.group) * cell.pmf * float(w) * float(h));
 }
 
 std::vector<double> VisibilityEnvironmentSampler::group_probabilities(const LightSampleContext &ctx) const {

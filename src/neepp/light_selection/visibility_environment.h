@@ -48,7 +48,7 @@ public:
 
     // P(g | table) for every group (tests and tools), and the group of a map point.
     std::vector<double> group_probabilities(const LightSampleContext &ctx) const;
-    uint32_t group_of(Vec2 uv) const { return group_of_cell_[env_.sampling_cell(uv)]; }
+    uint32_t group_of(Vec2 uv) const { return cells_[env_.sampling_cell(uv)].group; }
     static constexpr uint32_t kGroups = VoxelGrid::kDirectionBins;
 
 private:
@@ -69,8 +69,13 @@ private:
     VisibilityEnvironmentOptions options_;
     TableKeys keys_;
     std::vector<Group> groups_;
-    std::vector<uint16_t> group_of_cell_;
-    std::vector<uint32_t> local_index_;  // a cell's index in its group's table
+    // Per sampling cell of the map, what its density needs, in one read: its group, and its probability
+    // within the group (0 for a cell the map never samples), exactly as its group's table reports it.
+    struct CellInfo {
+        float pmf = 0;
+        uint32_t group = 0;
+    };
+    std::vector<CellInfo> cells_;
     LazyVoxelArray<GroupTable> tables_;
     uint64_t passes_ = 0;
 };

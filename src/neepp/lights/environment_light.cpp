@@ -255,14 +255,8 @@ DirectionSample ConstantEnvironmentLight::sample_direction(const Vec3 &ref, Vec2
 }
 
 DirectionSample PointLight::sample_direction(const Vec3 &ref, Vec2, Color &radiance) const {
-    DirectionSample ds;
-    Vec3 d = position_ - ref;
-    float dist2 = squared_norm(d);
-    ds.p = position_;
-    ds.dist = std::sqrt(dist2);
-    ds.d = d / ds.dist;
-    ds.pdf = 1.f;
-    ds.delta = true;
+    float dist2;
+    const DirectionSample ds = direction_sample_to_point(position_, ref, dist2);
     radiance = intensity_ / dist2;  // arriving radiance-equivalent: I / r^2 (the pdf is 1 for the delta)
     return ds;
 }

@@ -1,5 +1,6 @@
 // The light interface: area lights on shapes, environment maps, constant environments and point lights.
 #pragma once
+#include <cmath>
 #include <cstdint>
 #include <memory>
 #include <optional>
@@ -111,6 +112,19 @@ inline DirectionSample direction_sample_from_hit(const Vec3 &ref, const SurfaceI
     Vec3 d = si.p - ref;
     ds.dist = norm(d);
     ds.d = ds.dist > 0 ? d / ds.dist : Vec3(0, 0, 1);
+    return ds;
+}
+// The one direction sample toward a light at a point (point, spot, projector lights: a delta, pdf 1) from
+// ref; dist2 receives the squared distance, which the light's arriving radiance divides by.
+inline DirectionSample direction_sample_to_point(const Vec3 &position, const Vec3 &ref, float &dist2) {
+    DirectionSample ds;
+    const Vec3 d = position - ref;
+    dist2 = squared_norm(d);
+    ds.p = position;
+    ds.dist = std::sqrt(dist2);
+    ds.d = d / ds.dist;
+    ds.pdf = 1.f;
+    ds.delta = true;
     return ds;
 }
 inline DirectionSample direction_sample_from_miss(const Vec3 &d) {

@@ -32,14 +32,8 @@ Color ProjectorLight::intensity(const Vec3 &w) const {
 }
 
 DirectionSample ProjectorLight::sample_direction(const Vec3 &ref, Vec2, Color &radiance) const {
-    DirectionSample ds;
-    const Vec3 d = position_ - ref;
-    const float dist2 = squared_norm(d);
-    ds.p = position_;
-    ds.dist = std::sqrt(dist2);
-    ds.d = d / ds.dist;
-    ds.pdf = 1.f;
-    ds.delta = true;
+    float dist2;
+    const DirectionSample ds = direction_sample_to_point(position_, ref, dist2);
     radiance = intensity(-ds.d) / dist2;
     return ds;
 }
