@@ -318,3 +318,24 @@ TEST(SceneLoader, OrthographicSensorLoads) {
         }
     }
 }
+
+// A <sampler> at the top level is made (so a bad one is an error) and used only where a sensor <ref>s it,
+// as in Mitsuba 3; alone it leaves the sensor's own (or the default) sampler in place.
+TEST(SceneLoader, TopLevelSamplerIsUsedOnlyThroughRefs) {
+    const std::string sampler = R"(<sampler type="stratified" id="s"><integer name="sample_count" value="9"/></sampler>)";
+    const std::string referenced = std::string("<scene version=\"3.0.0\">\n") + sampler +
+                                   "\n<sensor type=\"perspective\"><ref id=\"s\"/></sensor>\n" + kLight + "\n</scene>\n";
+    auto scene = load_scene(write_temp_scene(referenced, "sampler_ref.xml"));
+    EXPECT_EQ(scene->settings.sampler, "stratified");
+    EXPECT_EQ(scene->settings.spp, 9);
+    const std::string alone = std::string("<scene version=\"3.0.0\">\n") + sampler + "\n" + kCamera + "\n" + kLight + "\n</scene>\n";
+    scene = load_scene(write_temp_scene(alone, "sampler_alone.xml"));
+    EXPECT_EQ(scene->settings.sampler, "independent");
+    EXPECT_EQ(scene->settings.spp, RenderSettings{}.spp);  // the sensor's own default
+    const std::string msg = load_error(scene_with(R"(<sampler type="halton"/>)"), "bad_sampler.xml");
+    EXPECT_NE(msg.find("bad_sampler.xml:3:"), std::string::npos) << msg;
+    EXPECT_NE(msg.find("unsupported sampler 'halton'"), std::string::npos) << msg;
+    EXPECT_NE(load_error(scene_with(R"(<sampler type="independent"><integer name="sample_count" value="0"/></sampler>)"))
+                  .find("sample_count must be at least 1"),
+              std::string::npos);
+}
