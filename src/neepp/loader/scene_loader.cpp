@@ -90,15 +90,28 @@ void load_sampler(const XmlNode &sampler, RenderSettings &settings) {
     loader::warn_unused(sampler);
 }
 
+void load_thin_lens(const XmlNode &sensor, Camera &cam) {
+    // Mitsuba's thinlens requires the radius, and refuses a camera transform that scales (the lens would
+    // no longer be a disk of that radius).
+    cam.aperture_radius = sensor.get_float("aperture_radius");
+    if (!cam.to_world.preserves_lengths(1e-3f))
+        throw sensor.error("the thinlens sensor's to_world must not scale (Mitsuba 3 refuses scale factors there)");
+    if (cam.aperture_radius == 0)  // Mitsuba warns too, and renders with a radius of float epsilon: a pinhole
+        loader::warn(sensor.file, sensor.line, "thinlens: aperture_radius 0 renders as a pinhole camera");
+}
+
 void load_sensor(const XmlNode &sensor, Scene &scene) {
-    if (sensor.type != "perspective" && sensor.type != "orthographic")
+    if (sensor.type != "perspective" && sensor.type != "thinlens" && sensor.type != "orthographic")
         throw sensor.error("unsupported sensor '" + sensor.type + "' (supported: " + supported_list("sensor") + ")");
     Camera &cam = scene.camera;
     cam.to_world = sensor.get_transform("to_world");
-    if (sensor.type == "perspective") loader::load_fov(sensor, cam);
-    else cam.projection = Projection::Orthographic;
+    if (sensor.type == "orthographic") cam.projection = Projection::Orthographic;
+    else loader::load_fov(sensor, cam);
     cam.near_clip = sensor.get_float("near_clip", 1e-2f);
     cam.far_clip = sensor.get_float("far_clip", 1e4f);
+    // Every Mitsuba projective sensor reads it; only a lens uses it.
+    cam.focus_distance = sensor.get_float("focus_distance", cam.far_clip);
+    if (sensor.type == "thinlens") load_thin_lens(sensor, cam);
     for (const auto &child : sensor.children) {
         if (child->tag == "film") {
             load_film(*child, scene);
