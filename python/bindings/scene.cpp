@@ -37,18 +37,22 @@ void bind_scene(nb::module_ &m) {
                 nb::list rows;
                 for (const auto &row : c.to_world.matrix.m) rows.append(nb::make_tuple(row[0], row[1], row[2], row[3]));
                 nb::dict d;
-                d["type"] = c.projection == Projection::Orthographic ? "orthographic" : "perspective";
+                d["type"] = c.projection == Projection::Orthographic ? "orthographic" : c.has_lens() ? "thinlens" : "perspective";
                 d["position"] = vec(c.position());
                 d["to_world"] = rows;
                 d["fov"] = c.fov;
                 d["fov_axis"] = c.fov_axis;
                 d["near_clip"] = c.near_clip;
                 d["far_clip"] = c.far_clip;
+                if (c.has_lens()) {
+                    d["aperture_radius"] = c.aperture_radius;
+                    d["focus_distance"] = c.focus_distance;
+                }
                 d["width"] = c.width;
                 d["height"] = c.height;
                 return d;
             },
-            "The camera: type (perspective, orthographic), position, to_world (4x4 rows), fov in degrees along fov_axis (perspective), clip distances, film size.")
+            "The camera: type (perspective, thinlens, orthographic), position, to_world (4x4 rows), fov in degrees along fov_axis (perspective, thinlens), clip distances, film size; a thinlens's aperture_radius and focus_distance.")
         .def_prop_ro("lights", [](const Scene &s) {
                 nb::list lights;
                 for (const auto &light : s.lights()) {

@@ -318,3 +318,59 @@ TEST(SceneLoader, OrthographicSensorLoads) {
         }
     }
 }
+
+// A <sampler> at the top level is made (so a bad one is an error) and used only where a sensor <ref>s it,
+// as in Mitsuba 3; alone it leaves the sensor's own (or the default) sampler in place.
+TEST(SceneLoader, TopLevelSamplerIsUsedOnlyThroughRefs) {
+    const std::string sampler = R"(<sampler type="stratified" id="s"><integer name="sample_count" value="9"/></sampler>)";
+    const std::string referenced = std::string("<scene version=\"3.0.0\">\n") + sampler +
+                                   "\n<sensor type=\"perspective\"><ref id=\"s\"/></sensor>\n" + kLight + "\n</scene>\n";
+    auto scene = load_scene(write_temp_scene(referenced, "sampler_ref.xml"));
+    EXPECT_EQ(scene->settings.sampler, "stratified");
+    EXPECT_EQ(scene->settings.spp, 9);
+    const std::string alone = std::string("<scene version=\"3.0.0\">\n") + sampler + "\n" + kCamera + "\n" + kLight + "\n</scene>\n";
+    scene = load_scene(write_temp_scene(alone, "sampler_alone.xml"));
+    EXPECT_EQ(scene->settings.sampler, "independent");
+    EXPECT_EQ(scene->settings.spp, RenderSettings{}.spp);  // the sensor's own default
+    const std::string msg = load_error(scene_with(R"(<sampler type="halton"/>)"), "bad_sampler.xml");
+    EXPECT_NE(msg.find("bad_sampler.xml:3:"), std::string::npos) << msg;
+    EXPECT_NE(msg.find("unsupported sampler 'halton'"), std::string::npos) << msg;
+    EXPECT_NE(load_error(scene_with(R"(<sampler type="independent"><integer name="sample_count" value="0"/></sampler>)"))
+                  .find("sample_count must be at least 1"),
+              std::string::npos);
+}
+
+// The thinlens sensor: its lens and focus distance load, its errors are Mitsuba's (a radius is required, a
+// scaling to_world is refused), and bdpt and light tracing refuse it with a clear message.
+TEST(SceneLoader, ThinLensSensorLoads) {
+    auto sensor = [](const std::string &props) {
+        return std::string("<scene version=\"3.0.0\">\n<sensor type=\"thinlens\"><float name=\"fov\" value=\"40\"/>") +
+               props + "<film type=\"hdrfilm\"><integer name=\"width\" value=\"8\"/><integer name=\"height\" value=\"8\"/></film></sensor>\n" +
+               kLight + "\n<shape type=\"sphere\"/>\n</scene>\n";
+    };
+    const std::string xml = sensor(R"(<float name="aperture_radius" value="0.25"/><float name="focus_distance" value="3"/>
+        <transform name="to_world"><lookat origin="0,0,-5" target="0,0,0" up="0,1,0"/></transform>)");
+    auto scene = load_scene(write_temp_scene(xml, "thinlens.xml"));
+    EXPECT_TRUE(scene->camera.has_lens());
+    EXPECT_FLOAT_EQ(scene->camera.aperture_radius, 0.25f);
+    EXPECT_FLOAT_EQ(scene->camera.focus_distance, 3.f);
+    EXPECT_FALSE(scene->camera.has_importance());
+    scene = load_scene(write_temp_scene(sensor(R"(<float name="aperture_radius" value="0.1"/>)"), "thinlens_far.xml"));
+    EXPECT_FLOAT_EQ(scene->camera.focus_distance, 1e4f);  // Mitsuba's default: the far clip distance
+    EXPECT_NE(load_error(sensor("")).find("aperture_radius"), std::string::npos);
+    EXPECT_NE(load_error(sensor(R"(<float name="aperture_radius" value="0.1"/><transform name="to_world"><scale value="2"/></transform>)"))
+                  .find("must not scale"),
+              std::string::npos);
+    EXPECT_NE(load_error(sensor(R"(<float name="aperture_radius" value="0.1"/><float name="focus_distance" value="-1"/>)"))
+                  .find("focus_distance must be greater than zero"),
+              std::string::npos);
+    const std::string path = write_temp_scene(xml, "thinlens_bdpt.xml");
+    for (const char *integrator : {"bdpt", "light"}) {
+        try {
+            render_scene_file(path, 1, 1, Options{}, integrator);
+            ADD_FAILURE() << integrator << " rendered a thinlens sensor";
+        } catch (const std::invalid_argument &e) {
+            EXPECT_NE(std::string(e.what()).find("thinlens"), std::string::npos) << e.what();
+        }
+    }
+}

@@ -131,3 +131,36 @@ TEST(Camera, BadClipDistancesAreRefused) {
     c.far_clip = 1.f;
     EXPECT_THROW(c.finalize(), std::invalid_argument);
 }
+
+// A thin lens: every ray of a film position passes through the point of the focal plane that the pinhole
+// ray of that position meets, starts on the lens disk (the near plane along its own direction), and the
+// lens centre traces the pinhole ray itself.
+TEST(Camera, ThinLensRaysMeetOnTheFocalPlane) {
+    Camera pin;
+    pin.to_world = Transform::look_at(Vec3(1, 2, 3), Vec3(0, 0, 0), Vec3(0, 1, 0));
+    pin.width = 40;
+    pin.height = 30;
+    pin.fov = 50.f;
+    pin.finalize();
+    Camera lens = pin;
+    lens.aperture_radius = 0.3f;
+    lens.focus_distance = 2.5f;
+    lens.finalize();
+    ASSERT_TRUE(lens.has_lens());
+    const Vec3 view = normalize(Vec3(0, 0, 0) - Vec3(1, 2, 3));
+    for (Vec2 film : {Vec2(0.5f, 0.5f), Vec2(0.1f, 0.8f), Vec2(0.93f, 0.2f)}) {
+        const Ray p = pin.generate_ray(film);
+        const Vec3 focus = pin.position() + p.d * (2.5f / dot(p.d, view));  // depth 2.5 along the view axis
+        const Ray centre = lens.generate_ray(film, Vec2(0.5f, 0.5f));
+        EXPECT_NEAR(norm(centre.d - p.d), 0.f, 1e-6f);
+        for (Vec2 u : {Vec2(0.1f, 0.2f), Vec2(0.9f, 0.5f), Vec2(0.4f, 0.99f)}) {
+            const Ray r = lens.generate_ray(film, u);
+            const Vec3 start = r.o - pin.position();
+            EXPECT_NEAR(dot(start, view), 0.f, 1e-5f);  // the lens lies in the camera's z = 0 plane...
+            EXPECT_LE(norm(start), 0.3f + 1e-5f);        // ...inside its radius
+            const float t = dot(focus - r.o, r.d);
+            EXPECT_NEAR(norm(r.at(t) - focus), 0.f, 1e-4f);
+            EXPECT_NEAR(r.tmin * dot(r.d, view), lens.near_clip, 1e-6f);  // from the near plane
+        }
+    }
+}

@@ -51,12 +51,17 @@ BDPTIntegrator::BDPTIntegrator(BDPTOptions options, std::unique_ptr<ShadowRayTes
 }
 
 void BDPTIntegrator::prepare(const Scene &scene) {
-    // Mitsuba 3's ptracer refuses such a sensor too (it has no sample_direction): a light path would meet
-    // an orthographic camera's rays with probability zero.
+    // An orthographic camera: Mitsuba 3's ptracer refuses it too (it has no sample_direction), as a light
+    // path would meet its rays with probability zero. A thin lens: Mitsuba's ptracer samples the lens, but
+    // neepp's light paths connect to a pinhole only (a lens point would be one more vertex to sample and
+    // weigh in MIS).
+    const std::string name = options_.light_tracer ? "light" : "bdpt";
+    if (scene.camera.has_lens())
+        throw std::invalid_argument(name + ": light paths cannot connect to the thinlens sensor in neepp (its lens "
+                                           "is not sampled by light paths); render this scene with the path integrator");
     if (!scene.camera.has_importance())
-        throw std::invalid_argument(std::string(options_.light_tracer ? "light" : "bdpt") +
-                                    ": the orthographic sensor cannot be reached by light paths (it has no "
-                                    "importance function); render this scene with the path integrator");
+        throw std::invalid_argument(name + ": the orthographic sensor cannot be reached by light paths (it has no "
+                                           "importance function); render this scene with the path integrator");
     shadow_->prepare(scene);
     queries_ = &shadow_->query_tester();
     if (options_.neepp_selection && !shadow_->visibility_map())

@@ -66,9 +66,10 @@ float PSSMLTIntegrator::evaluate(const Scene &scene, PrimarySampleSpaceSampler &
     out.clear();
     sampler.start_evaluation();
     const Camera &cam = scene.camera;
-    // The film position, as the render loop draws it: the first two numbers of the camera stream.
+    // The film position and lens point, as the render loop draws them: the first numbers of the camera stream.
     const Vec2 u = sampler.next_2d();
-    const Ray ray = cam.generate_ray(u);
+    const Vec2 lens = cam.has_lens() ? sampler.next_2d() : Vec2(0.5f, 0.5f);
+    const Ray ray = cam.generate_ray(u, lens);
     ContributionList splats(out);
     const Color L = inner_->splats() ? inner_->Li_splat(scene, ray, sampler, counters, splats)
                                      : inner_->Li(scene, ray, sampler, counters);

@@ -1,6 +1,7 @@
 #include "neepp/loader/supported_plugins.h"
 #include "neepp/loader/scene_loader.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdlib>
 #include <set>
@@ -77,24 +78,45 @@ void load_film(const XmlNode &film, Scene &scene) {
     loader::warn_unused(film);
 }
 
+// Mitsuba instantiates a <sampler> wherever it stands, so a bad one is an error even where nothing uses it.
+void load_sampler(const XmlNode &sampler, RenderSettings &settings) {
+    const std::vector<std::string> &names = supported_names("sampler");
+    if (std::find(names.begin(), names.end(), sampler.type) == names.end())
+        throw sampler.error("unsupported sampler '" + sampler.type + "' (supported: " + supported_list("sampler") + ")");
+    settings.sampler = sampler.type;
+    settings.spp = sampler.get_int("sample_count", 4);
+    settings.seed = uint64_t(sampler.get_int("seed", 0));
+    if (settings.spp < 1) throw sampler.error("sample_count must be at least 1");
+    loader::warn_unused(sampler);
+}
+
+void load_thin_lens(const XmlNode &sensor, Camera &cam) {
+    // Mitsuba's thinlens requires the radius, and refuses a camera transform that scales (the lens would
+    // no longer be a disk of that radius).
+    cam.aperture_radius = sensor.get_float("aperture_radius");
+    if (!cam.to_world.preserves_lengths(1e-3f))
+        throw sensor.error("the thinlens sensor's to_world must not scale (Mitsuba 3 refuses scale factors there)");
+    if (cam.aperture_radius == 0)  // Mitsuba warns too, and renders with a radius of float epsilon: a pinhole
+        loader::warn(sensor.file, sensor.line, "thinlens: aperture_radius 0 renders as a pinhole camera");
+}
+
 void load_sensor(const XmlNode &sensor, Scene &scene) {
-    if (sensor.type != "perspective" && sensor.type != "orthographic")
+    if (sensor.type != "perspective" && sensor.type != "thinlens" && sensor.type != "orthographic")
         throw sensor.error("unsupported sensor '" + sensor.type + "' (supported: " + supported_list("sensor") + ")");
     Camera &cam = scene.camera;
     cam.to_world = sensor.get_transform("to_world");
-    if (sensor.type == "perspective") loader::load_fov(sensor, cam);
-    else cam.projection = Projection::Orthographic;
+    if (sensor.type == "orthographic") cam.projection = Projection::Orthographic;
+    else loader::load_fov(sensor, cam);
     cam.near_clip = sensor.get_float("near_clip", 1e-2f);
     cam.far_clip = sensor.get_float("far_clip", 1e4f);
+    // Every Mitsuba projective sensor reads it; only a lens uses it.
+    cam.focus_distance = sensor.get_float("focus_distance", cam.far_clip);
+    if (sensor.type == "thinlens") load_thin_lens(sensor, cam);
     for (const auto &child : sensor.children) {
         if (child->tag == "film") {
             load_film(*child, scene);
         } else if (child->tag == "sampler") {
-            scene.settings.sampler = child->type;
-            scene.settings.spp = child->get_int("sample_count", 4);
-            scene.settings.seed = uint64_t(child->get_int("seed", 0));
-            if (scene.settings.spp < 1) throw child->error("sample_count must be at least 1");
-            loader::warn_unused(*child);
+            load_sampler(*child, scene.settings);
         } else {
             throw child->error("unexpected <" + child->tag + "> inside the sensor");
         }
@@ -119,11 +141,12 @@ std::unique_ptr<Scene> read_scene(const std::string &path, const std::map<std::s
     scene->source_path = path;
     loader::Factories factories;
     bool have_sensor = false;
-    // Elements that shapes hold (an area emitter may be declared at the top level and <ref>'d by a shape).
-    std::set<const XmlNode *> in_shapes;
+    // Elements that shapes hold (an area emitter may be declared at the top level and <ref>'d by a shape),
+    // and those sensors hold (a sampler may be too, and is then read once, by the sensor).
+    std::set<const XmlNode *> in_shapes, in_sensors;
     for (const auto &node : root->children)
-        if (node->tag == "shape")
-            for (const auto &child : node->children) in_shapes.insert(child.get());
+        if (node->tag == "shape" || node->tag == "sensor")
+            for (const auto &child : node->children) (node->tag == "shape" ? in_shapes : in_sensors).insert(child.get());
     for (const auto &node : root->children) attempt([&] {  // when checking, a broken element is left out
         const std::string &tag = node->tag;
         if (tag == "shape") {
@@ -138,6 +161,11 @@ std::unique_ptr<Scene> read_scene(const std::string &path, const std::map<std::s
             if (have_sensor) throw node->error("only one sensor is supported");
             load_sensor(*node, *scene);
             have_sensor = true;
+        } else if (tag == "sampler") {
+            // Mitsuba makes it and leaves it to the <ref>s that use it (a sensor's): alone it changes nothing,
+            // but is checked all the same.
+            RenderSettings unused_settings;
+            if (!in_sensors.count(node.get())) load_sampler(*node, unused_settings);
         } else if (tag == "integrator") {
             loader::load_integrator(*node, scene->settings);
         } else if (tag == "bsdf" || tag == "texture") {

@@ -16,7 +16,8 @@ const std::vector<std::pair<std::string, std::vector<std::string>>> &supported_p
         {"sensor", {"perspective", "orthographic"}},
         {"film", {"hdrfilm"}},
         {"rfilter", {"box", "tent", "gaussian"}},
-        {"sampler", {"independent", "sobol"}},
+        // Mitsuba's stratified and low-discrepancy samplers render with neepp's sobol: the same expected image.
+        {"sampler", {"independent", "sobol", "stratified", "multijitter", "ldsampler", "orthogonal"}},
         // Mitsuba 3's integrators, each rendered by neepp's own that gives the same image (loader/integrators.cpp).
         {"integrator", {"path", "bdpt", "light", "pssmlt", "prb", "prb_basic", "volpath", "volpathmis", "direct",
                         "ptracer", "moment"}},
@@ -24,14 +25,16 @@ const std::vector<std::pair<std::string, std::vector<std::string>>> &supported_p
     return plugins;
 }
 
-std::string supported_list(const std::string &kind) {
+const std::vector<std::string> &supported_names(const std::string &kind) {
     for (const auto &[k, names] : supported_plugins())
-        if (k == kind) {
-            std::string list;
-            for (const std::string &n : names) list += (list.empty() ? "" : ", ") + n;
-            return list;
-        }
-    throw std::logic_error("supported_list: no plugin kind '" + kind + "'");
+        if (k == kind) return names;
+    throw std::logic_error("supported_names: no plugin kind '" + kind + "'");
+}
+
+std::string supported_list(const std::string &kind) {
+    std::string list;
+    for (const std::string &n : supported_names(kind)) list += (list.empty() ? "" : ", ") + n;
+    return list;
 }
 
 }  // namespace neepp

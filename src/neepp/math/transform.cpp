@@ -123,12 +123,12 @@ bool Transform::flips_handedness() const {
     return det < 0;
 }
 
-bool Transform::preserves_lengths() const {
+bool Transform::preserves_lengths(float tolerance) const {
     for (int i = 0; i < 3; ++i)
         for (int j = 0; j < 3; ++j) {
             float d = 0;
             for (int k = 0; k < 3; ++k) d += matrix.m[k][i] * matrix.m[k][j];
-            if (std::abs(d - (i == j ? 1.f : 0.f)) >= 1e-6f) return false;
+            if (std::abs(d - (i == j ? 1.f : 0.f)) >= tolerance) return false;
         }
     return true;
 }

@@ -37,9 +37,9 @@ struct Transform {
     Vec3 normal(const Vec3 &n) const;
     // Whether the transform flips orientation (negative determinant of the linear part).
     bool flips_handedness() const;
-    // Whether the linear part is a rotation, or one with a reflection (orthonormal columns, to 1e-6): then
-    // vector() keeps unit vectors unit.
-    bool preserves_lengths() const;
+    // Whether the linear part is a rotation, or one with a reflection (orthonormal columns, to tolerance):
+    // then vector() keeps unit vectors unit.
+    bool preserves_lengths(float tolerance = 1e-6f) const;
 
 private:
     static Vec3 linear(const Matrix4 &m, const Vec3 &v) {

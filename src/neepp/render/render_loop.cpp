@@ -266,7 +266,9 @@ RenderResult render(const Scene &scene, Integrator &integrator, const RenderJob 
                                 sampler.start_sample(uint32_t(x + cam.crop_x), uint32_t(y + cam.crop_y), uint32_t(s));
                                 Vec2 jitter = sampler.next_2d();
                                 film_pos[queued] = Vec2(float(x) + jitter.x, float(y) + jitter.y);
-                                rays[queued] = cam.pixel_ray(x, y, jitter);
+                                // As Mitsuba: a lens's sample follows the film position's.
+                                const Vec2 lens = cam.has_lens() ? sampler.next_2d() : Vec2(0.5f, 0.5f);
+                                rays[queued] = cam.pixel_ray(x, y, jitter, lens);
                                 if (splatting) {
                                     add(film_pos[queued], integrator.Li_splat(scene, rays[queued], sampler, c, *splats_pass));
                                     continue;

@@ -60,9 +60,9 @@ float SobolSampler::next_1d() {
 
 std::unique_ptr<Sampler> make_sampler(const std::string &name, uint64_t seed) {
     if (name == "independent") return std::make_unique<IndependentSampler>(seed);
-    if (name == "sobol" || name == "multijitter" || name == "ldsampler" || name == "orthogonal")
+    if (name == "sobol" || name == "stratified" || name == "multijitter" || name == "ldsampler" || name == "orthogonal")
         return std::make_unique<SobolSampler>(seed);
-    throw std::invalid_argument("unknown sampler '" + name + "' (supported: independent, sobol)");
+    throw std::invalid_argument("unknown sampler '" + name + "' (supported: independent, sobol, or Mitsuba's stratified, multijitter, ldsampler, orthogonal as sobol)");
 }
 
 }  // namespace neepp

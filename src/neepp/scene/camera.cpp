@@ -3,6 +3,8 @@
 #include <cmath>
 #include <stdexcept>
 
+#include "neepp/math/warp.h"
+
 namespace neepp {
 
 void Camera::finalize() {
@@ -11,6 +13,10 @@ void Camera::finalize() {
     if (!ortho && !(fov > 0 && fov < 180)) throw std::invalid_argument("fov must be in (0, 180) degrees");
     if (!(near_clip > 0)) throw std::invalid_argument("near_clip must be greater than zero");
     if (!(near_clip < far_clip)) throw std::invalid_argument("near_clip must be smaller than far_clip");
+    if (!(aperture_radius >= 0) || !std::isfinite(aperture_radius))
+        throw std::invalid_argument("aperture_radius must be zero or more");
+    if (has_lens() && !(focus_distance > 0 && std::isfinite(focus_distance)))
+        throw std::invalid_argument("focus_distance must be greater than zero");
     const int fw = film_width > 0 ? film_width : width, fh = film_width > 0 ? film_height : height;
     float t = ortho ? 1.f : std::tan(0.5f * fov * kPi / 180.f);
     float w = float(fw), h = float(fh), aspect = w / h;
@@ -51,21 +57,30 @@ void Camera::crop(int x, int y, int w, int h) {
     height = h;
 }
 
-Ray Camera::generate_ray(Vec2 film) const {
-    return film_ray(image_offset_ + Vec2(film.x * image_scale_.x, film.y * image_scale_.y));
+Ray Camera::generate_ray(Vec2 film, Vec2 lens) const {
+    return film_ray(image_offset_ + Vec2(film.x * image_scale_.x, film.y * image_scale_.y), lens);
 }
 
-Ray Camera::pixel_ray(int x, int y, Vec2 jitter) const {
+Ray Camera::pixel_ray(int x, int y, Vec2 jitter, Vec2 lens) const {
     const int fw = film_width > 0 ? film_width : width, fh = film_width > 0 ? film_height : height;
-    return film_ray({(float(x + crop_x) + jitter.x) / float(fw), (float(y + crop_y) + jitter.y) / float(fh)});
+    return film_ray({(float(x + crop_x) + jitter.x) / float(fw), (float(y + crop_y) + jitter.y) / float(fh)}, lens);
 }
 
-Ray Camera::film_ray(Vec2 film) const {
+Ray Camera::film_ray(Vec2 film, Vec2 lens) const {
     float x = (1.f - 2.f * film.x) * tan_x_, y = (1.f - 2.f * film.y) * tan_y_;
     if (projection == Projection::Orthographic) {
         // As Mitsuba: from the near plane, in world units along the ray (a to_world scale of z scales where
         // the near plane is, not how far the ray goes).
         return Ray{to_world.point(Vec3(x, y, near_clip)), normalize(axis_z_), 0.f, far_clip - near_clip};
+    }
+    if (has_lens()) {
+        // As Mitsuba's thinlens: the point at depth focus_distance that the film position sees through the
+        // lens centre, seen from a uniform point of the lens disk; the ray starts at the near plane.
+        const Vec2 a = square_to_uniform_disk_concentric(lens) * aperture_radius;
+        const Vec3 lens_p(a.x, a.y, 0.f);
+        const Vec3 local = normalize(Vec3(x, y, 1.f) * focus_distance - lens_p);
+        const float inv_z = 1.f / local.z;
+        return Ray{to_world.point(lens_p), normalize(to_world.vector(local)), near_clip * inv_z, far_clip * inv_z};
     }
     Vec3 d_cam(x, y, 1.f);
     Vec3 d = axis_x_ * d_cam.x + axis_y_ * d_cam.y + axis_z_ * d_cam.z;

@@ -57,7 +57,8 @@ Prepass camera_prepass(const Scene &scene, const SeedingOptions &opt) {
         for (size_t i = r.begin(); i != r.end(); ++i) {
             PCG32 rng(mix_bits(opt.seed ^ mix_bits(i)), 1);
             Vec2 film{(float(i % G) + rng.next_float()) / float(G), (float(i / G) + rng.next_float()) / float(G)};
-            Ray ray = scene.camera.generate_ray(film);
+            const Vec2 lens = scene.camera.has_lens() ? rng.next_2d() : Vec2(0.5f, 0.5f);
+            Ray ray = scene.camera.generate_ray(film, lens);
             for (int b = 0; b < B; ++b) {
                 SurfaceInteraction si;
                 if (!scene.intersect(ray, si)) break;
