@@ -36,6 +36,13 @@ TexturePtr Factories::texture(const XmlNode &node) {
         tex = std::make_shared<CheckerboardTexture>(texture_param(node, "color0", Color(0.4f)),
                                                     texture_param(node, "color1", Color(0.2f)),
                                                     node.get_transform("to_uv"));
+    } else if (node.type == "rawconstant") {
+        // The value as written, neither colour-converted nor range-checked (a normal map's raw (0.5, 0.5, 1)):
+        // a float is broadcast to three channels, a vector kept per channel.
+        if (!node.has("value")) throw node.error("needs a 'value' (a float or a vector)");
+        bool scalar = node.props.at("value").kind == XmlProperty::Kind::Float ||
+                      node.props.at("value").kind == XmlProperty::Kind::Integer;
+        tex = constant_texture(scalar ? Color(node.get_float("value")) : Color(node.get_vector("value")));
     } else {
         throw node.error("unsupported texture type '" + node.type + "' (supported: " + supported_list("texture") + ")");
     }
