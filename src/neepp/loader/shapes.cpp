@@ -313,13 +313,11 @@ void Factories::emitter(const XmlNode &node, Scene &scene) {
             throw node.error(e.what());
         }
     } else if (t == "spot") {
-        for (const auto &child : node.children)
-            if (child->name == "texture" || child->tag == "texture") throw child->error("a spot light's projected texture is not supported");
         const float cutoff = node.get_float("cutoff_angle", 20.f);
         const float beam = node.get_float("beam_width", cutoff * 3.f / 4.f);
         try {
             scene.add_light(std::make_unique<SpotLight>(node.get_transform("to_world"), node.get_rgb("intensity", Color(1.f)),
-                                                        cutoff, beam));
+                                                        cutoff, beam, texture_param_or_null(node, "texture")));
         } catch (const std::invalid_argument &e) {
             throw node.error(e.what());
         }
