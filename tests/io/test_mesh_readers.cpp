@@ -188,6 +188,66 @@ TEST(PlyReader, AllEncodingsGiveTheSameMesh) {
     }
 }
 
+// Properties Mitsuba does not read itself become attributes, grouped by its rules: r g b (a) is
+// vertex_color, prefix_0/1/2 and prefix_x/y/z runs of 1 or 3 are vertex_prefix, prefix_r/g/b is
+// vertex_prefix_color; runs of 2, or out of sequence, are dropped. Values are kept as stored (no
+// division of integer colours by 255). A face's values go to each triangle the face becomes.
+TEST(PlyReader, GroupsOtherPropertiesIntoAttributesAsMitsubaDoes) {
+    TempDir tmp;
+    const std::string ply = R"(ply
+format ascii 1.0
+element vertex 4
+property float x
+property float y
+property float z
+property uchar red
+property uchar green
+property uchar blue
+property float w_0
+property float w_1
+property float w_2
+property float pair_x
+property float pair_y
+property float t_r
+property float t_g
+property float t_b
+property float single_x
+property float bad_x
+property float bad_z
+property float u
+property float v
+element face 2
+property float weight_0
+property list uchar int vertex_indices
+property float tint_x
+property float tint_y
+property float tint_z
+end_header
+0 0 0 255 0 0 1 2 3 9 9 0.1 0.2 0.3 7 8 8 0 0
+1 0 0 0 255 0 4 5 6 9 9 0.4 0.5 0.6 7 8 8 1 0
+1 1 0 0 0 255 7 8 9 9 9 0.7 0.8 0.9 7 8 8 1 1
+0 1 0 1 2 3 10 11 12 9 9 1 1 1 7 8 8 0 1
+0.5 4 0 1 2 3 0.1 0.2 0.3
+0.25 3 0 2 3 1 1 1
+)";
+    const MeshData m = read_ply(tmp.write("attrs.ply", ply));
+    ASSERT_EQ(m.triangle_count(), 3u);
+    ASSERT_EQ(m.uvs.size(), 4u);
+    std::vector<std::string> names;
+    for (const MeshAttribute &a : m.attributes) names.push_back(a.name + "/" + std::to_string(a.dim));
+    EXPECT_EQ(names, (std::vector<std::string>{"vertex_color/3", "vertex_w/3", "vertex_t_color/3", "vertex_single/1",
+                                               "face_weight/1", "face_tint/3"}));
+    EXPECT_EQ(m.attributes[0].values, (std::vector<float>{255, 0, 0, 0, 255, 0, 0, 0, 255, 1, 2, 3}));
+    EXPECT_EQ(m.attributes[1].values[5], 6.f);
+    EXPECT_FLOAT_EQ(m.attributes[2].values[7], 0.8f);
+    EXPECT_EQ(m.attributes[3].values, (std::vector<float>{7, 7, 7, 7}));
+    EXPECT_EQ(m.attributes[4].values, (std::vector<float>{0.5f, 0.5f, 0.25f}));  // the quad's two triangles
+    EXPECT_FLOAT_EQ(m.attributes[5].values[3 * 1 + 2], 0.3f);
+    EXPECT_FLOAT_EQ(m.attributes[5].values[3 * 2 + 0], 1.f);
+    EXPECT_TRUE(m.attributes[4].per_face());
+    EXPECT_FALSE(m.attributes[0].per_face());
+}
+
 TEST(PlyReader, RejectsBadFiles) {
     TempDir tmp;
     std::string good = sample_ply("binary_little_endian");

@@ -241,6 +241,35 @@ TEST(XmlTree, IncludesFilesRelativeToTheIncludingFile) {
     EXPECT_EQ(shapes[0]->resolve_path("x.obj"), (tmp.dir / "x.obj").lexically_normal().string());
 }
 
+// A nested <include> is looked for as Mitsuba's file resolver finds it: beside the including file, then
+// beside the files that included that one (innermost first), then in the <path> folders and the scene's
+// folder (the render suite's participating_media/include/test-scene-base.xml includes
+// "include/preamble.xml", which only the scene's folder has).
+TEST(XmlTree, NestedIncludesFallBackToIncludersPathFoldersAndSceneFolder) {
+    TempDir tmp;
+    tmp.write("inc/base.xml", scene(R"(
+  <include filename="inc/pre.xml"/><include filename="frag.xml"/><include filename="near.xml"/>
+  <include filename="deeper/d.xml"/>)"));
+    tmp.write("inc/pre.xml", scene(R"(<bsdf type="diffuse" id="pre"/>)"));
+    tmp.write("common/frag.xml", scene(R"(<bsdf type="diffuse" id="frag"/>)"));
+    tmp.write("inc/near.xml", scene(R"(<bsdf type="diffuse" id="near_beside"/>)"));
+    tmp.write("near.xml", scene(R"(<bsdf type="diffuse" id="near_scene"/>)"));
+    tmp.write("inc/deeper/d.xml", scene(R"(<include filename="up.xml"/>)"));
+    tmp.write("inc/up.xml", scene(R"(<bsdf type="diffuse" id="up"/>)"));
+    std::string path = tmp.write("s.xml", scene(R"(<path value="common"/><include filename="inc/base.xml"/>)"));
+    std::vector<std::string> ids;
+    for (const auto &b : parse_mitsuba_xml(path)->children_with_tag("bsdf")) ids.push_back(b->id);
+    EXPECT_EQ(ids, (std::vector<std::string>{"pre", "frag", "near_beside", "up"}));
+    // Found nowhere: the error names the file as looked for beside the including file.
+    tmp.write("inc/lost.xml", scene(R"(<include filename="gone.xml"/>)"));
+    try {
+        parse_mitsuba_xml(tmp.write("t.xml", scene(R"(<include filename="inc/lost.xml"/>)")));
+        FAIL() << "expected an error";
+    } catch (const SceneError &e) {
+        EXPECT_NE(std::string(e.what()).find((tmp.dir / "inc/gone.xml").string()), std::string::npos) << e.what();
+    }
+}
+
 // <path value="..."/> adds a folder (relative to the file naming it) that files are looked for in first,
 // the last added first, then the scene's folder; Mitsuba 3's render suite uses it in 39 of its 41 scenes.
 TEST(XmlTree, PathElementsAddSearchFolders) {

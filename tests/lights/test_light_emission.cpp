@@ -8,6 +8,7 @@
 #include "neepp/lights/environment_light.h"
 #include "neepp/lights/projector_light.h"
 #include "neepp/lights/spot_light.h"
+#include "neepp/materials/bitmap_texture.h"
 #include "neepp/math/frame.h"
 #include "neepp/materials/texture.h"
 #include "neepp/sampling/rng.h"
@@ -179,6 +180,56 @@ TEST(LightEmission, SpotLightEmitsIntoItsConeWithItsFalloff) {
     EXPECT_TRUE(ds.delta);
     EXPECT_NEAR(radiance.x, 3.f * 0.5f / 4.f, 1e-3f);
     EXPECT_THROW(tilted_spot(20.f, 20.f), std::invalid_argument);
+}
+
+namespace {
+
+// A 4 x 4 bitmap whose texels are all distinct, so a wrong uv shows.
+TexturePtr distinct_texels() {
+    Image img(4, 4, 3);
+    for (int y = 0; y < 4; ++y)
+        for (int x = 0; x < 4; ++x) {
+            img.at(x, y, 0) = 0.1f + 0.2f * float(x);
+            img.at(x, y, 1) = 0.1f + 0.2f * float(y);
+            img.at(x, y, 2) = 0.05f + 0.06f * float(x + 4 * y);
+        }
+    BitmapOptions o;
+    o.filter = FilterType::Nearest;
+    o.raw = true;
+    return std::make_shared<BitmapTexture>(img, o);
+}
+
+}  // namespace
+
+// A spot light's projected texture (Mitsuba's uv = 0.5 + 0.5 (x, y) / (z tan cutoff) in its local frame)
+// multiplies its intensity; its rays still fill the cone uniformly, and power() is their flux.
+TEST(LightEmission, SpotLightProjectsItsTextureOverTheCone) {
+    const Transform to_world = Transform::look_at(Vec3(0.5f, 2.f, -1.f), Vec3(0.2f, 0.f, 0.3f), Vec3(0, 1, 0));
+    const TexturePtr tex = distinct_texels();
+    const SpotLight light(to_world, Color(3.f, 2.f, 1.f), 30.f, 20.f, tex);
+    expect_round_trip(light);
+    const Chi2Result r = chi2_directions(light, Vec2(0.5f, 0.5f));
+    ASSERT_TRUE(r.error.empty()) << r.describe();
+    EXPECT_GT(r.p_value, 1e-4) << r.describe();
+    EXPECT_NEAR(mean_flux(light), luminance(light.power()), 3e-3 * luminance(light.power()));
+    // Inside the beam: local (x, y, 1) with x = t tan(cutoff) looks up u = 0.5 + 0.5 t; local +y is v.
+    const float tan_c = std::tan(30.f * kPi / 180.f);
+    for (auto [tx, ty] : {std::pair{0.2f, 0.1f}, std::pair{-0.3f, 0.25f}, std::pair{0.1f, -0.4f}}) {
+        const Vec3 w = normalize(to_world.vector(Vec3(tx * tan_c, ty * tan_c, 1.f)));
+        ASSERT_EQ(light.falloff(w), 1.f);
+        SurfaceInteraction si;
+        si.uv = Vec2(0.5f + 0.5f * tx, 0.5f + 0.5f * ty);
+        const Color expect = Color(3.f, 2.f, 1.f) * tex->eval(si);
+        const Color got = light.intensity(w);
+        EXPECT_NEAR(got.x, expect.x, 1e-5f);
+        EXPECT_NEAR(got.y, expect.y, 1e-5f);
+        EXPECT_NEAR(got.z, expect.z, 1e-5f);
+        Color radiance;
+        light.sample_direction(Vec3(0.5f, 2.f, -1.f) + w * 2.f, Vec2(0.5f, 0.5f), radiance);
+        EXPECT_NEAR(radiance.z, expect.z / 4.f, 1e-5f);
+    }
+    // Mitsuba refuses a texture that does not vary.
+    EXPECT_THROW(SpotLight(to_world, Color(1.f), 30.f, 20.f, constant_texture(Color(0.5f))), std::invalid_argument);
 }
 
 // Mitsuba's directional light: every emitted ray travels along its direction, from a disk across the

@@ -18,6 +18,17 @@ SENSOR = """<sensor type="perspective"><float name="fov" value="@FOV@"/>
   </sensor>"""
 
 
+def slide() -> np.ndarray:
+    """A 6 x 3 RGB image for projected-light tests: a bright corner, a dark column and colours that differ
+    left to right and top to bottom, so a mirrored, flipped or stretched projection shows."""
+    img = np.full((3, 6, 3), 0.3, np.float32)
+    img[0, 0] = (3.0, 2.5, 2.0)
+    img[:, 4] = 0.0
+    img[2, :, 0] = 1.2
+    img[:, 1, 2] = 1.5
+    return img
+
+
 def sensor(fov: float, origin: str, target: str) -> str:
     return SENSOR.replace("@FOV@", str(fov)).replace("@ORIGIN@", origin).replace("@TARGET@", target)
 

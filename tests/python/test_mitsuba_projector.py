@@ -6,10 +6,9 @@ with Mitsuba 3's images: the mean within 1 % plus 4 standard errors, each of 3 x
 plus 4 standard errors."""
 from __future__ import annotations
 
-import numpy as np
 import pytest
 
-from mitsuba_compare import mitsuba_render, neepp_agrees, sensor
+from mitsuba_compare import mitsuba_render, neepp_agrees, sensor, slide
 from neepp_tools import REPO_ROOT, exr
 
 OUT = REPO_ROOT / ".cache" / "test_mitsuba_projector"
@@ -36,16 +35,6 @@ PROJECTORS = {
               '<string name="filter_type" value="nearest"/></texture>'
               '<float name="fov" value="40"/><string name="fov_axis" value="y"/><float name="scale" value="2.5"/>',
 }
-
-
-def slide() -> np.ndarray:
-    """6 x 3: a bright corner, a dark column and colours that differ left to right and top to bottom."""
-    img = np.full((3, 6, 3), 0.3, np.float32)
-    img[0, 0] = (3.0, 2.5, 2.0)
-    img[:, 4] = 0.0
-    img[2, :, 0] = 1.2
-    img[:, 1, 2] = 1.5
-    return img
 
 
 @pytest.fixture(scope="module", params=list(PROJECTORS))

@@ -1,4 +1,4 @@
-"""Mitsuba 3's `disk` and `cylinder` shapes, `spot` and `directional` lights, `null` and `roughdielectric`
+"""Mitsuba 3's `disk` and `cylinder` shapes, `spot` (plain and projecting a texture) and `directional` lights, `null` and `roughdielectric`
 BSDFs: small scenes
 of the project's own (a spot light across a floor, a tilted cylinder between p0 and p1, a disk-shaped area light
 and a tilted diffuse disk; a sun-like directional light on a floor, a glossy sphere and a box) rendered by
@@ -9,8 +9,8 @@ from __future__ import annotations
 
 import pytest
 
-from mitsuba_compare import mitsuba_render, neepp_agrees, sensor
-from neepp_tools import REPO_ROOT
+from mitsuba_compare import mitsuba_render, neepp_agrees, sensor, slide
+from neepp_tools import REPO_ROOT, exr
 
 OUT = REPO_ROOT / ".cache" / "test_mitsuba_shapes_lights"
 
@@ -29,6 +29,23 @@ SHAPES_AND_SPOT = """<scene version="3.0.0">
     <bsdf type="diffuse"><rgb name="reflectance" value="0.8,0.6,0.3"/></bsdf></shape>
   <emitter type="spot"><transform name="to_world"><lookat origin="-1.5,2.5,1.5" target="0,0,0" up="0,1,0"/></transform>
     <rgb name="intensity" value="20"/><float name="cutoff_angle" value="25"/></emitter>
+</scene>
+"""
+
+# A spot light projecting a bitmap over its cone (uneven and asymmetric, so a mirrored or flipped projection
+# shows), tilted, onto a floor and a box under a dim sky.
+TEXTURED_SPOT = """<scene version="3.0.0">
+  <default name="spp" value="16"/>
+  <integrator type="path"><integer name="max_depth" value="4"/></integrator>
+  @SENSOR@
+  <shape type="rectangle"><transform name="to_world"><scale value="3"/><rotate x="1" angle="-90"/></transform>
+    <bsdf type="diffuse"><rgb name="reflectance" value="0.6"/></bsdf></shape>
+  <shape type="cube"><transform name="to_world"><scale value="0.3"/><rotate y="1" angle="20"/><translate x="-0.5" y="0.3" z="0.2"/></transform>
+    <bsdf type="diffuse"><rgb name="reflectance" value="0.7,0.5,0.3"/></bsdf></shape>
+  <emitter type="spot"><transform name="to_world"><lookat origin="-0.6,2.4,1.2" target="0.1,0,-0.1" up="0,1,0"/></transform>
+    <rgb name="intensity" value="6"/><float name="cutoff_angle" value="35"/><float name="beam_width" value="25"/>
+    <texture type="bitmap" name="texture"><string name="filename" value="slide.exr"/></texture></emitter>
+  <emitter type="constant"><rgb name="radiance" value="0.05"/></emitter>
 </scene>
 """
 
@@ -87,13 +104,15 @@ ROUGH_DIELECTRIC = """<scene version="3.0.0">
 """
 
 SCENES = {name: xml.replace("@SENSOR@", sensor(60, "0,1.2,3.2", "0,0.6,0"))
-          for name, xml in {"shapes_and_spot": SHAPES_AND_SPOT, "directional": DIRECTIONAL,
+          for name, xml in {"shapes_and_spot": SHAPES_AND_SPOT, "textured_spot": TEXTURED_SPOT, "directional": DIRECTIONAL,
                             "null_bsdf": NULL_BSDF, "rough_dielectric": ROUGH_DIELECTRIC}.items()}
 
 
 @pytest.fixture(scope="module", params=list(SCENES))
 def scene_and_reference(request, tmp_path_factory):
-    xml = tmp_path_factory.mktemp("shapes_lights") / f"{request.param}.xml"
+    d = tmp_path_factory.mktemp("shapes_lights")
+    exr.write_exr(d / "slide.exr", slide())
+    xml = d / f"{request.param}.xml"
     xml.write_text(SCENES[request.param])
     return xml, mitsuba_render(xml, OUT / f"mitsuba_{request.param}.exr", spp=1024, seed=2)
 

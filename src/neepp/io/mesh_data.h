@@ -14,11 +14,22 @@
 
 namespace neepp {
 
+// A per-vertex or per-face attribute of a mesh (Mitsuba's "vertex_color", "face_weight"...), read by the
+// mesh_attribute texture: dim (1, 3, or 4 with alpha) floats per vertex or per triangle, as stored.
+struct MeshAttribute {
+    std::string name;  // with its "vertex_" or "face_" prefix
+    int dim = 1;
+    std::vector<float> values;
+
+    bool per_face() const { return name.rfind("face_", 0) == 0; }
+};
+
 struct MeshData {
     std::vector<Vec3> positions;
     std::vector<Vec3> normals;  // empty when the file has none; else one per position, unit length or zero
     std::vector<Vec2> uvs;      // empty when the file has none; else one per position
     std::vector<uint32_t> indices;  // three per triangle, in the file's winding order
+    std::vector<MeshAttribute> attributes;  // face attributes have one entry per triangle
 
     size_t triangle_count() const { return indices.size() / 3; }
 };

@@ -3,6 +3,7 @@
 // in skipped elements.
 #include "neepp/io/ply_reader.h"
 
+#include <algorithm>
 #include <array>
 #include <bit>
 #include <cstring>
@@ -198,6 +199,73 @@ private:
     }
 };
 
+// An attribute as found in a PLY element: its name and the properties holding its components.
+struct AttributeLayout {
+    std::string name;
+    std::vector<int> props;
+};
+
+// Mitsuba 3's grouping of the properties it does not read itself into attributes (src/shapes/ply.h):
+// r, g, b (or red, green, blue), with a or alpha, make "<type>color"; other runs of consecutive
+// properties named prefix_c, with c going x y z w, r g b a, 0 1 2 3 or 1 2 3 4, make "<type>prefix"
+// ("<type>prefix_color" for r g b), kept with 1 or 3 components (4 for a colour with alpha). Anything
+// else is skipped, as Mitsuba skips it (with a warning there).
+std::vector<AttributeLayout> attribute_layouts(const PlyElement &el, const std::string &type,
+                                               const std::vector<std::string> &reserved) {
+    std::vector<AttributeLayout> out;
+    auto is_reserved = [&](const PlyProperty &p) {
+        return p.list || std::find(reserved.begin(), reserved.end(), p.name) != reserved.end();
+    };
+    for (auto names : {std::array<const char *, 4>{"r", "g", "b", "a"}, std::array<const char *, 4>{"red", "green", "blue", "alpha"}}) {
+        const int r = el.find({names[0]}), g = el.find({names[1]}), b = el.find({names[2]});
+        if (r < 0 || g < 0 || b < 0) continue;
+        AttributeLayout color{type + "color", {r, g, b}};
+        if (const int a = el.find({names[3]}); a >= 0) color.props.push_back(a);
+        out.push_back(color);
+        break;
+    }
+    const char *kPostfixes[4] = {"xr01", "yg12", "zb23", "wa34"};  // row: component; column: naming scheme
+    std::vector<std::string> seen;
+    AttributeLayout current;
+    int scheme = -1;
+    auto flush = [&] {
+        if (scheme >= 0 && (current.props.size() == 1 || current.props.size() == 3)) {
+            seen.push_back(current.name);
+            current.name = type + current.name + (scheme == 1 ? "_color" : "");
+            out.push_back(current);
+        }
+        current = {};
+        scheme = -1;
+    };
+    for (size_t k = 0; k < el.props.size(); ++k) {
+        const PlyProperty &p = el.props[k];
+        if (is_reserved(p) || p.name == "r" || p.name == "g" || p.name == "b" || p.name == "a") continue;
+        const size_t cut = p.name.find_last_of('_');
+        if (cut == std::string::npos || cut + 2 != p.name.size()) {
+            flush();
+            continue;
+        }
+        const std::string prefix = p.name.substr(0, cut);
+        const char c = p.name.back();
+        if (scheme >= 0 && prefix != current.name) flush();
+        if (scheme < 0) {
+            if (std::find(seen.begin(), seen.end(), prefix) != seen.end()) continue;
+            const char *at = std::strchr(kPostfixes[0], c);
+            if (!at) continue;
+            scheme = int(at - kPostfixes[0]);
+            current = {prefix, {int(k)}};
+        } else if (current.props.size() < 4 && kPostfixes[current.props.size()][scheme] == c) {
+            current.props.push_back(int(k));
+        } else {  // out of sequence: Mitsuba drops the attribute
+            seen.push_back(current.name);
+            current = {};
+            scheme = -1;
+        }
+    }
+    flush();
+    return out;
+}
+
 template <class Source>
 class BodyReader {
 public:
@@ -258,26 +326,69 @@ private:
         // Mitsuba's accepted texture coordinate names, in its order of preference.
         bool uvs = map(6, {{"u"}, {"v"}}) || map(6, {{"texture_u"}, {"texture_v"}}) || map(6, {{"s"}, {"t"}});
 
+        std::vector<std::string> reserved{"x", "y", "z", "nx", "ny", "nz"};
+        for (int k = 0; k < int(slot.size()); ++k)
+            if (slot[k] >= 6) reserved.push_back(el.props[k].name);
+        const std::vector<AttributeLayout> layouts = attribute_layouts(el, "vertex_", reserved);
+        Attributes attrs(layouts, el, m);
+
         m.positions.resize(el.count);
         if (normals) m.normals.resize(el.count);
         if (uvs) m.uvs.resize(el.count);
         float values[8] = {};
         for (size_t r = 0; r < el.count; ++r) {
-            read_record(el, [&](size_t k, double v) { if (slot[k] >= 0) values[slot[k]] = float(v); }, nullptr);
+            read_record(el, [&](size_t k, double v) {
+                if (slot[k] >= 0) values[slot[k]] = float(v);
+                attrs.store(k, v);
+            }, nullptr);
             m.positions[r] = Vec3(values[0], values[1], values[2]);
             if (normals) m.normals[r] = Vec3(values[3], values[4], values[5]);
             if (uvs) m.uvs[r] = Vec2(values[6], values[7]);
+            attrs.next_record(1);
         }
     }
+
+    // Gathers a record's attribute values (by property index) and appends them, once per vertex or once
+    // per triangle a face became.
+    class Attributes {
+    public:
+        Attributes(const std::vector<AttributeLayout> &layouts, const PlyElement &el, MeshData &m)
+            : first_(m.attributes.size()), m_(m), where_(el.props.size(), {-1, -1}) {
+            for (size_t a = 0; a < layouts.size(); ++a) {
+                m.attributes.push_back({layouts[a].name, int(layouts[a].props.size()), {}});
+                for (size_t c = 0; c < layouts[a].props.size(); ++c) where_[layouts[a].props[c]] = {int(a), int(c)};
+            }
+            record_.resize(layouts.size() * 4);
+        }
+        void store(size_t prop, double v) {
+            if (where_[prop].first >= 0) record_[where_[prop].first * 4 + where_[prop].second] = float(v);
+        }
+        void next_record(size_t copies) {
+            for (size_t a = first_; a < m_.attributes.size(); ++a) {
+                MeshAttribute &attr = m_.attributes[a];
+                for (size_t i = 0; i < copies; ++i)
+                    attr.values.insert(attr.values.end(), record_.begin() + (a - first_) * 4,
+                                       record_.begin() + (a - first_) * 4 + attr.dim);
+            }
+        }
+
+    private:
+        size_t first_;
+        MeshData &m_;
+        std::vector<std::pair<int, int>> where_;  // property -> (attribute, component)
+        std::vector<float> record_;
+    };
 
     void read_faces(const PlyElement &el, MeshData &m) {
         int list = el.find({"vertex_indices", "vertex_index"});
         if (list < 0 || !el.props[list].list)
             throw SceneError(path_, "PLY face element lacks a vertex_indices/vertex_index list");
         m.indices.reserve(m.indices.size() + el.count * 3);
+        Attributes attrs(attribute_layouts(el, "face_", {}), el, m);
         for (size_t r = 0; r < el.count; ++r) {
-            read_record(el, [](size_t, double) {}, &el.props[list]);
+            read_record(el, [&](size_t k, double v) { attrs.store(k, v); }, &el.props[list]);
             for (size_t k = 2; k < list_.size(); ++k) m.indices.insert(m.indices.end(), {list_[0], list_[k - 1], list_[k]});
+            attrs.next_record(list_.size() >= 3 ? list_.size() - 2 : 0);  // each triangle of the face has its values
         }
     }
 };

@@ -285,6 +285,7 @@ private:
     std::map<std::string, std::shared_ptr<XmlNode>> ids_;
     std::string base_dir_;
     std::shared_ptr<std::vector<std::string>> search_dirs_ = std::make_shared<std::vector<std::string>>();
+    std::vector<std::string> includer_dirs_;  // folders of the files whose <include> is being read, outermost first
 
     void add_param(const std::string &name, const std::string &value, bool from_default) {
         Param p{"$" + name, value, from_default};
@@ -626,12 +627,36 @@ private:
         fail(src, op, "unexpected <" + std::string(tag) + "> inside <transform>");
     }
 
+    // Where Mitsuba's file resolver finds an included file: beside the including file, then beside each
+    // file that (transitively) included it, innermost first (each <include> puts its file's folder in
+    // front of the resolver for what it reads), then the <path> folders and the scene's folder. The
+    // first candidate is the one a missing file is reported as.
+    fs::path include_path(const SourceFile &src, const fs::path &name) const {
+        if (name.is_absolute()) return name;
+        std::vector<fs::path> dirs{src.dir};
+        dirs.insert(dirs.end(), includer_dirs_.rbegin(), includer_dirs_.rend());
+        dirs.insert(dirs.end(), search_dirs_->rbegin(), search_dirs_->rend());
+        dirs.push_back(base_dir_);
+        for (const fs::path &d : dirs) {
+            std::error_code ec;
+            if (fs::exists(d / name, ec)) return (d / name).lexically_normal();
+        }
+        return (fs::path(src.dir) / name).lexically_normal();
+    }
+
     void include(const SourceFile &src, pugi::xml_node el, XmlNode &parent, int depth) {
         if (depth + 1 >= kMaxIncludeDepth) fail(src, el, "<include> nested too deeply (is a file including itself?)");
-        fs::path file(el.attribute("filename").value());
-        if (file.is_relative()) file = fs::path(src.dir) / file;
+        fs::path file = include_path(src, el.attribute("filename").value());
         if (!fs::exists(file)) fail(src, el, "included file \"" + file.string() + "\" not found");
-        std::shared_ptr<XmlNode> root = parse_file(file.lexically_normal().string(), depth + 1);
+        includer_dirs_.push_back(src.dir);
+        std::shared_ptr<XmlNode> root;
+        try {
+            root = parse_file(file.string(), depth + 1);
+        } catch (...) {
+            includer_dirs_.pop_back();
+            throw;
+        }
+        includer_dirs_.pop_back();
         if (root->tag != "scene") {
             add_child(src, el, parent, root, el.attribute("name").value());
             return;

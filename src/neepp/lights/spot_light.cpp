@@ -6,12 +6,15 @@
 
 namespace neepp {
 
-SpotLight::SpotLight(const Transform &to_world, Color intensity, float cutoff_angle_deg, float beam_width_deg)
-    : to_world_(to_world), intensity_(intensity) {
+SpotLight::SpotLight(const Transform &to_world, Color intensity_value, float cutoff_angle_deg, float beam_width_deg,
+                     TexturePtr texture)
+    : to_world_(to_world), intensity_(intensity_value), texture_(std::move(texture)) {
     if (!(cutoff_angle_deg > 0 && cutoff_angle_deg <= 180))
         throw std::invalid_argument("cutoff_angle must be in (0, 180] degrees");
     if (!(beam_width_deg >= 0 && beam_width_deg < cutoff_angle_deg))
         throw std::invalid_argument("beam_width must be in [0, cutoff_angle)");
+    if (texture_ && texture_->is_constant())
+        throw std::invalid_argument("a spot light's 'texture' must vary over uv (a bitmap, say): fold a constant into 'intensity'");
     position_ = to_world.point(Vec3(0.f));
     axis_ = normalize(to_world.vector(Vec3(0, 0, 1)));
     cutoff_rad_ = cutoff_angle_deg * kPi / 180.f;
@@ -19,15 +22,32 @@ SpotLight::SpotLight(const Transform &to_world, Color intensity, float cutoff_an
     inv_transition_ = 1.f / (cutoff_rad_ - beam_rad);
     cos_cutoff_ = std::cos(cutoff_rad_);
     cos_beam_ = std::cos(beam_rad);
-    // ∫ falloff dω = 2π ∫ falloff(θ) sin θ dθ, by the midpoint rule (smooth: 4096 steps are exact to 1e-7).
-    double s = 0;
-    const int n = 4096;
-    for (int i = 0; i < n; ++i) {
-        const double theta = (i + 0.5) * cutoff_rad_ / n;
-        const double f = theta <= beam_rad ? 1.0 : (cutoff_rad_ - theta) * inv_transition_;
-        s += f * std::sin(theta);
+    uv_factor_ = std::tan(cutoff_rad_);
+    if (!texture_) {
+        // ∫ falloff dω = 2π ∫ falloff(θ) sin θ dθ, by the midpoint rule (smooth: 4096 steps are exact to 1e-7).
+        double s = 0;
+        const int n = 4096;
+        for (int i = 0; i < n; ++i) {
+            const double theta = (i + 0.5) * cutoff_rad_ / n;
+            const double f = theta <= beam_rad ? 1.0 : (cutoff_rad_ - theta) * inv_transition_;
+            s += f * std::sin(theta);
+        }
+        power_ = intensity_ * float(2 * M_PI * s * cutoff_rad_ / n);
+        return;
     }
-    falloff_solid_angle_ = float(2 * M_PI * s * cutoff_rad_ / n);
+    // With a texture the integrand has no symmetry: the midpoint rule over the square the uniform cone
+    // warp maps onto the cone (area-preserving up to its constant density), fine enough for a bitmap's
+    // texels to average out.
+    const int n = 512;
+    double sum[3] = {0, 0, 0};
+    for (int j = 0; j < n; ++j)
+        for (int i = 0; i < n; ++i) {
+            const Vec3 local = square_to_uniform_cone(Vec2((i + 0.5f) / n, (j + 0.5f) / n), cos_cutoff_);
+            const Color c = intensity(normalize(to_world_.vector(local)));
+            sum[0] += c.x, sum[1] += c.y, sum[2] += c.z;
+        }
+    const double scale = 1.0 / (double(n) * n * square_to_uniform_cone_pdf(cos_cutoff_));
+    power_ = Color(float(sum[0] * scale), float(sum[1] * scale), float(sum[2] * scale));
 }
 
 float SpotLight::falloff(const Vec3 &w) const {
@@ -37,10 +57,19 @@ float SpotLight::falloff(const Vec3 &w) const {
     return (cutoff_rad_ - std::acos(std::min(cos_theta, 1.f))) * inv_transition_;
 }
 
+Color SpotLight::intensity(const Vec3 &w) const {
+    const float f = falloff(w);
+    if (!texture_ || f == 0.f) return intensity_ * f;  // no texture lookup outside the cone, as Mitsuba
+    const Vec3 local = to_world_.inverse_vector(w);
+    SurfaceInteraction si;
+    si.uv = Vec2(0.5f + 0.5f * local.x / (local.z * uv_factor_), 0.5f + 0.5f * local.y / (local.z * uv_factor_));
+    return intensity_ * texture_->eval(si) * f;
+}
+
 DirectionSample SpotLight::sample_direction(const Vec3 &ref, Vec2, Color &radiance) const {
     float dist2;
     const DirectionSample ds = direction_sample_to_point(position_, ref, dist2);
-    radiance = intensity_ * (falloff(-ds.d) / dist2);  // as a point light's, through the falloff
+    radiance = intensity(-ds.d) / dist2;  // as a point light's, through the falloff and texture
     return ds;
 }
 
@@ -49,7 +78,7 @@ EmissionSample SpotLight::sample_emission(Vec2, Vec2 u_dir) const {
     es.p = position_;
     const Vec3 local = square_to_uniform_cone(u_dir, cos_cutoff_);
     es.ray = Ray{position_, normalize(to_world_.vector(local)), 0.f, kInfinity};
-    es.radiance = intensity_ * falloff(es.ray.d);
+    es.radiance = intensity(es.ray.d);
     es.pdf_pos = 1.f;
     es.pdf_dir = square_to_uniform_cone_pdf(cos_cutoff_);
     return es;

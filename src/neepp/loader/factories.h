@@ -50,6 +50,9 @@ void load_integrator(const XmlNode &node, RenderSettings &settings);
 // Moves a shape (a mesh or a sphere) by to_world, its normals with it; throws std::runtime_error when
 // the result is not finite, or when it would make a sphere an ellipsoid.
 void transform_shape(Shape &s, const Transform &to_world);
+// Throws, naming the shape, when a mesh_attribute texture under bsdf_node reads an attribute the shape
+// lacks (Mitsuba fails at render time; here it fails at load).
+void check_mesh_attributes(const XmlNode &bsdf_node, const Shape &shape, const XmlNode &shape_node);
 // Reports properties that no builder read (misspelt or unsupported) on stderr, as Mitsuba does.
 void warn_unused(const XmlNode &node);
 // A perspective projection's angle of view (a perspective sensor's, a projector's): fov along fov_axis,

@@ -181,6 +181,7 @@ void set_mesh(Shape &s, MeshData mesh, const Transform &to_world) {
     s.normals = std::move(mesh.normals);
     s.uvs = std::move(mesh.uvs);
     s.indices = std::move(mesh.indices);
+    if (!mesh.attributes.empty()) s.attributes = std::make_shared<const std::vector<MeshAttribute>>(std::move(mesh.attributes));
     transform_shape(s, to_world);
     if (!s.face_normals && s.normals.empty()) compute_vertex_normals(s);
 }
@@ -269,7 +270,10 @@ std::unique_ptr<Shape> Factories::build_shape(const XmlNode &node, const XmlNode
     emitter_node = nullptr;
     for (const auto &child : node.children) {
         attempt([&] {  // when checking, a broken BSDF leaves the shape the default one
-            if (child->tag == "bsdf") s->bsdf = bsdf(*child);
+            if (child->tag == "bsdf") {
+                s->bsdf = bsdf(*child);
+                check_mesh_attributes(*child, *s, node);
+            }
             else if (child->tag == "emitter") emitter_node = child.get();
             else if (child->tag == "medium" || child->tag == "ref" && (child->name == "interior" || child->name == "exterior"))
                 throw child->error("participating media are not supported yet (the shape's " +
@@ -313,13 +317,11 @@ void Factories::emitter(const XmlNode &node, Scene &scene) {
             throw node.error(e.what());
         }
     } else if (t == "spot") {
-        for (const auto &child : node.children)
-            if (child->name == "texture" || child->tag == "texture") throw child->error("a spot light's projected texture is not supported");
         const float cutoff = node.get_float("cutoff_angle", 20.f);
         const float beam = node.get_float("beam_width", cutoff * 3.f / 4.f);
         try {
             scene.add_light(std::make_unique<SpotLight>(node.get_transform("to_world"), node.get_rgb("intensity", Color(1.f)),
-                                                        cutoff, beam));
+                                                        cutoff, beam, texture_param_or_null(node, "texture")));
         } catch (const std::invalid_argument &e) {
             throw node.error(e.what());
         }

@@ -11,7 +11,7 @@ const std::vector<std::pair<std::string, std::vector<std::string>>> &supported_p
         {"bsdf", {"diffuse", "twosided", "mask", "bumpmap", "conductor", "roughconductor", "plastic", "roughplastic",
                   "dielectric", "roughdielectric", "thindielectric", "principled", "principledthin", "null", "normalmap",
                   "blendbsdf"}},
-        {"texture", {"bitmap", "checkerboard"}},
+        {"texture", {"bitmap", "checkerboard", "rawconstant", "mesh_attribute"}},
         {"emitter", {"area", "envmap", "constant", "point", "spot", "directional", "projector"}},
         {"sensor", {"perspective", "orthographic"}},
         {"film", {"hdrfilm"}},

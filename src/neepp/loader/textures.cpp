@@ -4,6 +4,7 @@
 #include "neepp/loader/problems.h"
 #include "neepp/materials/bitmap_texture.h"
 #include "neepp/materials/checkerboard_texture.h"
+#include "neepp/materials/mesh_attribute_texture.h"
 
 namespace neepp::loader {
 
@@ -36,12 +37,42 @@ TexturePtr Factories::texture(const XmlNode &node) {
         tex = std::make_shared<CheckerboardTexture>(texture_param(node, "color0", Color(0.4f)),
                                                     texture_param(node, "color1", Color(0.2f)),
                                                     node.get_transform("to_uv"));
+    } else if (node.type == "mesh_attribute") {
+        try {
+            tex = std::make_shared<MeshAttributeTexture>(node.get_string("name"), node.get_float("scale", 1.f));
+        } catch (const std::invalid_argument &e) {
+            throw node.error(e.what());
+        }
+    } else if (node.type == "rawconstant") {
+        // The value as written, neither colour-converted nor range-checked (a normal map's raw (0.5, 0.5, 1)):
+        // a float is broadcast to three channels, a vector kept per channel.
+        if (!node.has("value")) throw node.error("needs a 'value' (a float or a vector)");
+        bool scalar = node.props.at("value").kind == XmlProperty::Kind::Float ||
+                      node.props.at("value").kind == XmlProperty::Kind::Integer;
+        tex = constant_texture(scalar ? Color(node.get_float("value")) : Color(node.get_vector("value")));
     } else {
         throw node.error("unsupported texture type '" + node.type + "' (supported: " + supported_list("texture") + ")");
     }
     warn_unused(node);
     textures_[&node] = tex;
     return tex;
+}
+
+void check_mesh_attributes(const XmlNode &bsdf_node, const Shape &shape, const XmlNode &shape_node) {
+    for (const auto &child : bsdf_node.children) {
+        if (child->tag == "texture" && child->type == "mesh_attribute") {
+            const std::string name = child->get_string("name");
+            if (!shape.attribute(name)) {
+                std::string have;
+                if (shape.attributes)
+                    for (const MeshAttribute &a : *shape.attributes) have += (have.empty() ? "" : ", ") + a.name;
+                throw shape_node.error("has no mesh attribute \"" + name + "\" (read by the mesh_attribute texture at " +
+                                       child->file + ":" + std::to_string(child->line) + "); it has " +
+                                       (have.empty() ? std::string("none") : have));
+            }
+        }
+        check_mesh_attributes(*child, shape, shape_node);
+    }
 }
 
 TexturePtr Factories::texture_param_or_null(const XmlNode &node, const std::string &name, bool unbounded) {

@@ -5,6 +5,7 @@
 #include <optional>
 #include <string>
 #include <vector>
+#include "neepp/io/mesh_data.h"
 #include "neepp/materials/bsdf.h"
 #include "neepp/math/bbox.h"
 #include "neepp/math/distribution.h"
@@ -30,6 +31,8 @@ struct Shape {
     std::vector<Vec3> positions, normals;
     std::vector<Vec2> uvs;
     std::vector<uint32_t> indices;
+    // Per-vertex and per-face attributes (of a PLY file), shared by the instances of one mesh.
+    std::shared_ptr<const std::vector<MeshAttribute>> attributes;
     bool face_normals = false;  // ignore vertex normals (Mitsuba's face_normals)
     bool flip_normals = false;
 
@@ -52,6 +55,14 @@ struct Shape {
     // Call once after the geometry is final: computes the area, the triangle-area distribution and the
     // per-triangle records that hits (and, for emitters, light samples) read.
     void finalize();
+    // The attribute of that name, null when the shape has none. Inline: textures (a library below this
+    // one) read it.
+    const MeshAttribute *attribute(const std::string &name) const {
+        if (attributes)
+            for (const MeshAttribute &a : *attributes)
+                if (a.name == name) return &a;
+        return nullptr;
+    }
     size_t triangle_count() const { return indices.size() / 3; }
     float surface_area() const { return area_; }
     BBox bounds() const;
