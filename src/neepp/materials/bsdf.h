@@ -92,6 +92,20 @@ public:
     float pdf(const BSDFContext &, const SurfaceInteraction &, const Vec3 &, const Vec3 &) const final { return 0.f; }
 };
 
+// Base of BSDFs that evaluate f and its density together (microfacet BSDFs: both share the half vector,
+// the microfacet terms and the texture lookups): eval and pdf are eval_pdf's two halves, so there is one
+// implementation of the formulas.
+class JointEvalBSDF : public BSDF {
+public:
+    Color eval(const BSDFContext &ctx, const SurfaceInteraction &si, const Vec3 &wi, const Vec3 &wo) const final {
+        return eval_pdf(ctx, si, wi, wo).f;
+    }
+    float pdf(const BSDFContext &ctx, const SurfaceInteraction &si, const Vec3 &wi, const Vec3 &wo) const final {
+        return eval_pdf(ctx, si, wi, wo).pdf;
+    }
+    BSDFEval eval_pdf(const BSDFContext &ctx, const SurfaceInteraction &si, const Vec3 &wi, const Vec3 &wo) const override = 0;
+};
+
 using BSDFPtr = std::shared_ptr<const BSDF>;
 
 }  // namespace neepp

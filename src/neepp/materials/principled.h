@@ -84,16 +84,9 @@ private:
     float alpha_2_;
 };
 
-class PrincipledBSDF final : public BSDF {
+class PrincipledBSDF final : public JointEvalBSDF {
 public:
     explicit PrincipledBSDF(PrincipledParams p);
-    // eval and pdf are eval_pdf's two halves (one implementation of the formulas).
-    Color eval(const BSDFContext &ctx, const SurfaceInteraction &si, const Vec3 &wi, const Vec3 &wo) const override {
-        return eval_pdf(ctx, si, wi, wo).f;
-    }
-    float pdf(const BSDFContext &ctx, const SurfaceInteraction &si, const Vec3 &wi, const Vec3 &wo) const override {
-        return eval_pdf(ctx, si, wi, wo).pdf;
-    }
     BSDFEval eval_pdf(const BSDFContext &ctx, const SurfaceInteraction &si, const Vec3 &wi, const Vec3 &wo) const override;
     BSDFSample sample(const BSDFContext &ctx, const SurfaceInteraction &si, const Vec3 &wi, float u1,
                       Vec2 u2) const override;

@@ -36,15 +36,9 @@ struct PrincipledThinParams {
           diffuse_reflectance_sampling_rate = 1.f, diffuse_transmittance_sampling_rate = 1.f;
 };
 
-class PrincipledThinBSDF final : public BSDF {
+class PrincipledThinBSDF final : public JointEvalBSDF {
 public:
     explicit PrincipledThinBSDF(PrincipledThinParams p);
-    Color eval(const BSDFContext &ctx, const SurfaceInteraction &si, const Vec3 &wi, const Vec3 &wo) const override {
-        return eval_pdf(ctx, si, wi, wo).f;
-    }
-    float pdf(const BSDFContext &ctx, const SurfaceInteraction &si, const Vec3 &wi, const Vec3 &wo) const override {
-        return eval_pdf(ctx, si, wi, wo).pdf;
-    }
     BSDFEval eval_pdf(const BSDFContext &ctx, const SurfaceInteraction &si, const Vec3 &wi, const Vec3 &wo) const override;
     BSDFSample sample(const BSDFContext &ctx, const SurfaceInteraction &si, const Vec3 &wi, float u1,
                       Vec2 u2) const override;

@@ -14,18 +14,11 @@
 
 namespace neepp {
 
-class RoughConductorBSDF final : public BSDF {
+class RoughConductorBSDF final : public JointEvalBSDF {
 public:
     // A null specular_reflectance means 1. For isotropic roughness pass the same texture twice.
     RoughConductorBSDF(MicrofacetType type, TexturePtr alpha_u, TexturePtr alpha_v, TexturePtr eta, TexturePtr k,
                        TexturePtr specular_reflectance = nullptr, bool sample_visible = true);
-    // eval and pdf are eval_pdf's two halves (one implementation of the formulas).
-    Color eval(const BSDFContext &ctx, const SurfaceInteraction &si, const Vec3 &wi, const Vec3 &wo) const override {
-        return eval_pdf(ctx, si, wi, wo).f;
-    }
-    float pdf(const BSDFContext &ctx, const SurfaceInteraction &si, const Vec3 &wi, const Vec3 &wo) const override {
-        return eval_pdf(ctx, si, wi, wo).pdf;
-    }
     BSDFEval eval_pdf(const BSDFContext &ctx, const SurfaceInteraction &si, const Vec3 &wi, const Vec3 &wo) const override;
     BSDFSample sample(const BSDFContext &, const SurfaceInteraction &si, const Vec3 &wi, float u1,
                       Vec2 u2) const override;

@@ -24,20 +24,13 @@
 
 namespace neepp {
 
-class RoughDielectricBSDF final : public BSDF {
+class RoughDielectricBSDF final : public JointEvalBSDF {
 public:
     // Null multipliers mean 1. For isotropic roughness pass the same texture twice. Throws
     // std::invalid_argument when the IORs are not positive or are equal (Mitsuba's check).
     RoughDielectricBSDF(MicrofacetType type, TexturePtr alpha_u, TexturePtr alpha_v, float int_ior, float ext_ior,
                         TexturePtr specular_reflectance = nullptr, TexturePtr specular_transmittance = nullptr,
                         bool sample_visible = true);
-    // eval and pdf are eval_pdf's two halves (one implementation of the formulas).
-    Color eval(const BSDFContext &ctx, const SurfaceInteraction &si, const Vec3 &wi, const Vec3 &wo) const override {
-        return eval_pdf(ctx, si, wi, wo).f;
-    }
-    float pdf(const BSDFContext &ctx, const SurfaceInteraction &si, const Vec3 &wi, const Vec3 &wo) const override {
-        return eval_pdf(ctx, si, wi, wo).pdf;
-    }
     BSDFEval eval_pdf(const BSDFContext &ctx, const SurfaceInteraction &si, const Vec3 &wi, const Vec3 &wo) const override;
     BSDFSample sample(const BSDFContext &ctx, const SurfaceInteraction &si, const Vec3 &wi, float u1,
                       Vec2 u2) const override;

@@ -19,18 +19,11 @@
 
 namespace neepp {
 
-class RoughPlasticBSDF final : public BSDF {
+class RoughPlasticBSDF final : public JointEvalBSDF {
 public:
     // A null specular_reflectance means 1.
     RoughPlasticBSDF(MicrofacetType type, float alpha, float int_ior, float ext_ior, TexturePtr diffuse_reflectance,
                      TexturePtr specular_reflectance = nullptr, bool nonlinear = false, bool sample_visible = true);
-    // eval and pdf are eval_pdf's two halves (one implementation of the formulas).
-    Color eval(const BSDFContext &ctx, const SurfaceInteraction &si, const Vec3 &wi, const Vec3 &wo) const override {
-        return eval_pdf(ctx, si, wi, wo).f;
-    }
-    float pdf(const BSDFContext &ctx, const SurfaceInteraction &si, const Vec3 &wi, const Vec3 &wo) const override {
-        return eval_pdf(ctx, si, wi, wo).pdf;
-    }
     BSDFEval eval_pdf(const BSDFContext &ctx, const SurfaceInteraction &si, const Vec3 &wi, const Vec3 &wo) const override;
     BSDFSample sample(const BSDFContext &ctx, const SurfaceInteraction &si, const Vec3 &wi, float u1,
                       Vec2 u2) const override;
