@@ -64,12 +64,12 @@ def vec(v):
     return "{" + ", ".join(f(x) for x in v) + "}"
 
 
-def main():
+def print_references(script, bsdfs):
+    """Prints the .inc lines for (name, plugin, parameters) triples: eval, pdf and sample at every query."""
     print("// Reference values generated with Mitsuba %s (pip package, scalar_rgb variant) by"
           % mi.__version__)
-    print("// tests/materials/generate_principled_reference.py; one line per query.")
-    for name, params in [*CONFIGS.items(), *THIN_CONFIGS.items()]:
-        plugin = "principledthin" if name in THIN_CONFIGS else "principled"
+    print(f"// tests/materials/{script}; one line per query.")
+    for name, plugin, params in bsdfs:
         bsdf = mi.load_dict({"type": plugin, **params})
         for mode_name, mode in (("Radiance", mi.TransportMode.Radiance), ("Importance", mi.TransportMode.Importance)):
             ctx = mi.BSDFContext(mode)
@@ -85,6 +85,12 @@ def main():
                     bs, weight = bsdf.sample(ctx, si, u1, mi.ScalarPoint2f(*u2))
                     print(head + f"Sample{{{f(u1)}, {vec(u2)}, {vec(bs.wo)}, {f(bs.pdf)}, {f(bs.eta)}, "
                           f"{vec(weight)}}}}},")
+
+
+def main():
+    print_references("generate_principled_reference.py",
+                     [*((n, "principled", p) for n, p in CONFIGS.items()),
+                      *((n, "principledthin", p) for n, p in THIN_CONFIGS.items())])
 
 
 if __name__ == "__main__":

@@ -11,7 +11,7 @@ import mitsuba as mi
 
 mi.set_variant("scalar_rgb")
 
-from generate_principled_reference import SAMPLES, WIS, WOS, f, vec  # noqa: E402
+from generate_principled_reference import print_references  # noqa: E402
 
 # Names and parameters; the C++ test builds the same (make_bsdfs in mitsuba_reference_test.cpp).
 CONFIGS = {
@@ -29,25 +29,8 @@ CONFIGS = {
 
 
 def main():
-    print("// Reference values generated with Mitsuba %s (pip package, scalar_rgb variant) by"
-          % mi.__version__)
-    print("// tests/materials/generate_roughdielectric_reference.py; one line per query.")
-    for name, params in CONFIGS.items():
-        bsdf = mi.load_dict({"type": "roughdielectric", **params})
-        for mode_name, mode in (("Radiance", mi.TransportMode.Radiance), ("Importance", mi.TransportMode.Importance)):
-            ctx = mi.BSDFContext(mode)
-            for wi in WIS:
-                si = mi.SurfaceInteraction3f()
-                si.wi = wi
-                head = f'    {{"{name}", TransportMode::{mode_name}, {vec(wi)}, '
-                for wo in WOS:
-                    value = bsdf.eval(ctx, si, wo)
-                    pdf = bsdf.pdf(ctx, si, wo)
-                    print(head + f"{vec(wo)}, Eval{{{vec(value)}, {f(pdf)}}}}},")
-                for u1, u2 in SAMPLES:
-                    bs, weight = bsdf.sample(ctx, si, u1, mi.ScalarPoint2f(*u2))
-                    print(head + f"Sample{{{f(u1)}, {vec(u2)}, {vec(bs.wo)}, {f(bs.pdf)}, {f(bs.eta)}, "
-                          f"{vec(weight)}}}}},")
+    print_references("generate_roughdielectric_reference.py",
+                     [(n, "roughdielectric", p) for n, p in CONFIGS.items()])
 
 
 if __name__ == "__main__":
