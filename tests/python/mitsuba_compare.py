@@ -33,6 +33,34 @@ def sensor(fov: float, origin: str, target: str) -> str:
     return SENSOR.replace("@FOV@", str(fov)).replace("@ORIGIN@", origin).replace("@TARGET@", target)
 
 
+# The bump- and normal-map tests' scene: a rough plastic plane under a perturbed shading frame (the
+# perturbing <bsdf> opens as @OPEN@, its flags at @FLAGS@), lit at a grazing angle by a small area light,
+# with a dim sky.
+PERTURBED_PLANE = """<scene version="3.0.0">
+  <default name="spp" value="64"/>
+  <integrator type="path"><integer name="max_depth" value="4"/></integrator>
+  @SENSOR@
+  <shape type="rectangle"><transform name="to_world"><scale value="1.5"/><rotate x="1" angle="-90"/></transform>
+    @OPEN@@FLAGS@
+      <bsdf type="roughplastic"><float name="alpha" value="0.15"/><rgb name="diffuse_reflectance" value="0.6,0.5,0.4"/></bsdf>
+    </bsdf></shape>
+  <shape type="rectangle"><transform name="to_world"><scale value="0.3"/><rotate y="1" angle="-90"/><translate x="2.5" y="0.25"/></transform>
+    <emitter type="area"><rgb name="radiance" value="40"/></emitter></shape>
+  <emitter type="constant"><rgb name="radiance" value="0.05"/></emitter>
+</scene>
+"""
+# Mitsuba's two defaults of both, on and off.
+PERTURBED_FLAGS = {"defaults": "",
+                   "off": '<boolean name="flip_invalid_normals" value="false"/><boolean name="use_shadowing_function" value="false"/>'}
+
+
+def perturbed_plane(opening: str, flags: str) -> str:
+    """PERTURBED_PLANE with its perturbing BSDF's opening (through the map's texture) and flags, seen from
+    above at 45°."""
+    return (PERTURBED_PLANE.replace("@OPEN@", opening).replace("@FLAGS@", flags)
+            .replace("@SENSOR@", sensor(45, "0,2.5,2.5", "0,0,0")))
+
+
 def mitsuba_render(xml, out, spp: int, seed: int):
     """Mitsuba 3's image of the scene file (RGB)."""
     out.parent.mkdir(parents=True, exist_ok=True)

@@ -10,27 +10,13 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from mitsuba_compare import mitsuba_render, neepp_agrees, sensor
+from mitsuba_compare import PERTURBED_FLAGS, mitsuba_render, neepp_agrees, perturbed_plane
 from neepp_tools import REPO_ROOT, exr
 
 OUT = REPO_ROOT / ".cache" / "test_mitsuba_normalmap"
 
-SCENE = """<scene version="3.0.0">
-  <default name="spp" value="64"/>
-  <integrator type="path"><integer name="max_depth" value="4"/></integrator>
-  @SENSOR@
-  <shape type="rectangle"><transform name="to_world"><scale value="1.5"/><rotate x="1" angle="-90"/></transform>
-    <bsdf type="normalmap">
-      <texture name="normalmap" type="bitmap"><string name="filename" value="normals.exr"/><boolean name="raw" value="true"/></texture>@FLAGS@
-      <bsdf type="roughplastic"><float name="alpha" value="0.15"/><rgb name="diffuse_reflectance" value="0.6,0.5,0.4"/></bsdf>
-    </bsdf></shape>
-  <shape type="rectangle"><transform name="to_world"><scale value="0.3"/><rotate y="1" angle="-90"/><translate x="2.5" y="0.25"/></transform>
-    <emitter type="area"><rgb name="radiance" value="40"/></emitter></shape>
-  <emitter type="constant"><rgb name="radiance" value="0.05"/></emitter>
-</scene>
-"""
-FLAGS = {"defaults": "",
-         "off": '<boolean name="flip_invalid_normals" value="false"/><boolean name="use_shadowing_function" value="false"/>'}
+OPENING = """<bsdf type="normalmap">
+      <texture name="normalmap" type="bitmap"><string name="filename" value="normals.exr"/><boolean name="raw" value="true"/></texture>"""
 
 
 def normal_map(size: int = 96) -> np.ndarray:
@@ -44,12 +30,12 @@ def normal_map(size: int = 96) -> np.ndarray:
     return ((n + 1) / 2).astype(np.float32)
 
 
-@pytest.fixture(scope="module", params=list(FLAGS))
+@pytest.fixture(scope="module", params=list(PERTURBED_FLAGS))
 def scene_and_reference(request, tmp_path_factory):
     folder = tmp_path_factory.mktemp("normalmap")
     exr.write_exr(folder / "normals.exr", normal_map())
     xml = folder / f"{request.param}.xml"
-    xml.write_text(SCENE.replace("@FLAGS@", FLAGS[request.param]).replace("@SENSOR@", sensor(45, "0,2.5,2.5", "0,0,0")))
+    xml.write_text(perturbed_plane(OPENING, PERTURBED_FLAGS[request.param]))
     return xml, mitsuba_render(xml, OUT / f"mitsuba_{request.param}.exr", spp=1024, seed=1)
 
 
