@@ -22,9 +22,9 @@ sample count (the test stays valid, it only loses power); scenes with participat
 out of scope. Columns: loads (or the first error), the pass fraction, neepp's mean over the reference's
 (sum of RGB), and mean z^2, which for an unbiased render estimates neepp's per-sample variance over the
 reference's. --mitsuba adds the same columns for Mitsuba 3 (pip, scalar_rgb) as a control. Mitsuba 3
-chooses among emitters uniformly (or by their sampling_weight) where neepp's path tracer defaults to their
-power: on scenes with several lights `-I light_sampler=uniform` makes the noise, and so mean z^2,
-comparable with Mitsuba's.
+chooses among emitters uniformly (or by their sampling_weight) where neepp's path tracer defaults to a light
+BVH: on scenes with several lights `-I light_sampler=uniform` makes the noise, and so mean z^2, the same
+as Mitsuba's.
 
 Writes bench/out/mitsuba_suite/ (git-ignored): the renders, results.json and table.md.
 """

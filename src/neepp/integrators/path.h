@@ -18,7 +18,7 @@ struct PathOptions {
     int rr_depth = 5;
     bool hide_emitters = false;
     bool nee = true;
-    std::string light_sampler = "power";
+    std::string light_sampler = "bvh";  // pbrt-v4's default too; measured best of the non-NEE++ choices (docs/neepp.md)
     std::string within_light = "own";  // how a point on the chosen light is sampled (WithinLightSampling)
     int voxels = 16;  // grid of the spatial light sampler when NEE++ keeps no map (else the map's grid)
 };
