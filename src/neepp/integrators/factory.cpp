@@ -1,7 +1,9 @@
 #include <algorithm>
+#include <set>
 #include <sstream>
 #include <stdexcept>
 #include "neepp/integrators/bdpt.h"
+#include "neepp/integrators/neepp_auto.h"
 #include "neepp/integrators/path.h"
 #include "neepp/integrators/pssmlt.h"
 #include "neepp/light_selection/factory.h"
@@ -83,30 +85,63 @@ std::unique_ptr<Integrator> make_bdpt(bool light_tracer, const Options &options)
     return std::make_unique<BDPTIntegrator>(o, std::move(shadow));
 }
 
+std::unique_ptr<Integrator> make_path(const Options &options) {
+    PathOptions o;
+    o.max_depth = options.get_int("max_depth", o.max_depth);
+    o.rr_depth = options.get_int("rr_depth", o.rr_depth);
+    o.hide_emitters = options.get_bool("hide_emitters", o.hide_emitters);
+    o.nee = options.get_bool("nee", o.nee);
+    o.light_sampler = options.get_string("light_sampler", o.light_sampler);
+    check_light_sampler_name(o.light_sampler);
+    o.within_light = options.get_string("within_light", o.within_light);
+    const auto &within = WithinLightSampling::names();
+    if (std::find(within.begin(), within.end(), o.within_light) == within.end())
+        throw std::invalid_argument("within_light must be 'own' or 'visibility', not '" + o.within_light + "'");
+    if (o.max_depth < -1 || o.max_depth == 0) throw std::invalid_argument("max_depth must be -1 or >= 1");
+    if (o.rr_depth < 1) throw std::invalid_argument("rr_depth must be >= 1");
+    const bool needs_map = light_sampler_needs_visibility_map(o.light_sampler) || o.within_light != "own";
+    if (o.light_sampler.rfind("spatial", 0) == 0 || needs_map || options.get_string("shadow_rays", "nee") != "nee")
+        o.voxels = options.get_int("voxels", o.voxels);
+    // A light sampler reading the map needs it from the first pass: no deferred seeding then.
+    std::unique_ptr<ShadowRayTester> shadow = make_shadow_ray_tester(options, needs_map, o.voxels, !needs_map);
+    return std::make_unique<PathIntegrator>(o, std::move(shadow));
+}
+
+// neepp=auto: the candidates' options are the user's with each candidate's overrides; every candidate is
+// built once here, so that a bad option is reported before the scene loads, and an option counts as
+// unused only if no candidate reads it.
+std::unique_ptr<Integrator> make_auto_path(const Options &options) {
+    for (const char *key : {"light_sampler", "within_light", "shadow_rays"})
+        if (options.has(key))
+            throw std::invalid_argument(std::string("neepp=auto chooses light_sampler, within_light and shadow_rays itself: "
+                                                    "drop -I ") + key + ", or use neepp=off");
+    std::map<std::string, std::string> values = options.values();
+    values.erase("neepp");
+    auto candidate_options = [values](const AutoCandidate &c) {
+        Options o(values);
+        for (const auto &[k, v] : c.overrides) o.set(k, v);
+        return o;
+    };
+    std::set<std::string> read;
+    for (const AutoCandidate &c : auto_candidates()) {
+        Options o = candidate_options(c);
+        make_path(o);
+        const std::vector<std::string> unused = o.unused();
+        for (const auto &[k, v] : values)
+            if (std::find(unused.begin(), unused.end(), k) == unused.end()) read.insert(k);
+    }
+    for (const std::string &k : read) options.get_string(k, "");  // read by some candidate: not unused
+    return std::make_unique<AutoIntegrator>(auto_candidates(),
+                                            [candidate_options](const AutoCandidate &c) { return make_path(candidate_options(c)); });
+}
 }  // namespace
 
 std::unique_ptr<Integrator> make_integrator(const std::string &name, const Options &options) {
     std::unique_ptr<Integrator> integrator;
     if (name == "path") {
-        PathOptions o;
-        o.max_depth = options.get_int("max_depth", o.max_depth);
-        o.rr_depth = options.get_int("rr_depth", o.rr_depth);
-        o.hide_emitters = options.get_bool("hide_emitters", o.hide_emitters);
-        o.nee = options.get_bool("nee", o.nee);
-        o.light_sampler = options.get_string("light_sampler", o.light_sampler);
-        check_light_sampler_name(o.light_sampler);
-        o.within_light = options.get_string("within_light", o.within_light);
-        const auto &within = WithinLightSampling::names();
-        if (std::find(within.begin(), within.end(), o.within_light) == within.end())
-            throw std::invalid_argument("within_light must be 'own' or 'visibility', not '" + o.within_light + "'");
-        if (o.max_depth < -1 || o.max_depth == 0) throw std::invalid_argument("max_depth must be -1 or >= 1");
-        if (o.rr_depth < 1) throw std::invalid_argument("rr_depth must be >= 1");
-        const bool needs_map = light_sampler_needs_visibility_map(o.light_sampler) || o.within_light != "own";
-        if (o.light_sampler.rfind("spatial", 0) == 0 || needs_map || options.get_string("shadow_rays", "nee") != "nee")
-            o.voxels = options.get_int("voxels", o.voxels);
-        // A light sampler reading the map needs it from the first pass: no deferred seeding then.
-        std::unique_ptr<ShadowRayTester> shadow = make_shadow_ray_tester(options, needs_map, o.voxels, !needs_map);
-        integrator = std::make_unique<PathIntegrator>(o, std::move(shadow));
+        const std::string mode = options.get_string("neepp", "off");
+        if (mode != "off" && mode != "auto") throw std::invalid_argument("neepp must be 'off' or 'auto', not '" + mode + "'");
+        integrator = mode == "auto" ? make_auto_path(options) : make_path(options);
     } else if (name == "bdpt" || name == "light") {
         integrator = make_bdpt(name == "light", options);
     } else if (name == "pssmlt") {

@@ -1,0 +1,229 @@
+#include "neepp/integrators/neepp_auto.h"
+
+#include <time.h>
+#include <atomic>
+#include <chrono>
+#include <optional>
+#include <fmt/format.h>
+#include <tbb/parallel_for.h>
+#include "neepp/integrators/path.h"
+#include "neepp/sampling/sampler.h"
+#include "neepp/visibility/neepp_shadow_rays.h"
+#include "neepp/scene/scene.h"
+
+namespace neepp {
+
+namespace {
+
+bool has_environment(const Scene &scene) { return !scene.infinite_lights().empty(); }
+bool several_lights(const Scene &scene) { return scene.lights().size() > 1; }
+
+// The NEE++ component of a candidate that keeps a visibility map, or null.
+NeeppShadowRays *map_keeper(Integrator &integrator) {
+    auto *path = dynamic_cast<PathIntegrator *>(&integrator);
+    return path ? dynamic_cast<NeeppShadowRays *>(&path->shadow_rays()) : nullptr;
+}
+
+double thread_cpu_seconds() {
+    timespec t{};
+    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
+    return double(t.tv_sec) + 1e-9 * double(t.tv_nsec);
+}
+
+// The pilot: kPilotSpp samples of each pixel of a grid over the film, through Li_batch as the render
+// loop calls it. The numbers depend on (pixel, sample) only, so every candidate sees the same camera
+// rays and, wherever its choices agree with another's, the same paths: the differences between their
+// variances are less noisy than the variances.
+struct PilotFigures {
+    double relative_variance = 0, seconds_per_sample = 0;
+    double sample_variance = 0;  // per sample, of a pixel's luminance (PassStatistics::sample_variance)
+};
+
+PilotFigures run_pilot(const Scene &scene, const Integrator &integrator, int first_sample) {
+    const Camera &cam = scene.camera;
+    const int gx = std::min(AutoIntegrator::kPilotGrid, cam.width), gy = std::min(AutoIntegrator::kPilotGrid, cam.height);
+    constexpr int K = AutoIntegrator::kPilotSpp;
+    std::vector<double> mean(size_t(gx) * gy), var(size_t(gx) * gy);
+    std::atomic<int64_t> cpu_ns{0};
+    const IndependentSampler prototype(0x9117ull);
+    tbb::parallel_for(0, gy, [&](int j) {
+        const double t0 = thread_cpu_seconds();
+        RenderCounters counters;  // the pilot's rays are not the render's
+        std::vector<std::unique_ptr<Sampler>> owned;
+        std::vector<Sampler *> samplers;
+        for (int k = 0; k < K; ++k) samplers.push_back(owned.emplace_back(prototype.clone()).get());
+        std::vector<Ray> rays(K);
+        std::vector<Color> out(K);
+        const int y = int((j + 0.5) * cam.height / gy);
+        for (int i = 0; i < gx; ++i) {
+            const int x = int((i + 0.5) * cam.width / gx);
+            for (int k = 0; k < K; ++k) {
+                Sampler &s = *samplers[k];
+                s.start_sample(uint32_t(x + cam.crop_x), uint32_t(y + cam.crop_y), uint32_t(first_sample + k));
+                const Vec2 jitter = s.next_2d();
+                const Vec2 lens = cam.has_lens() ? s.next_2d() : Vec2(0.5f, 0.5f);
+                rays[k] = cam.pixel_ray(x, y, jitter, lens);
+            }
+            integrator.Li_batch(scene, rays, samplers, out, counters);
+            double m = 0, m2 = 0;
+            for (const Color &c : out) {
+                const double l = is_finite(c) ? double(luminance(c)) : 0.0;
+                m += l;
+                m2 += l * l;
+            }
+            m /= K;
+            const size_t p = size_t(j) * gx + i;
+            mean[p] = m;
+            var[p] = std::max(0.0, (m2 - K * m * m) / (K - 1));
+        }
+        cpu_ns += int64_t((thread_cpu_seconds() - t0) * 1e9);
+    });
+    double sum_mean = 0, sum_var = 0;
+    for (size_t p = 0; p < mean.size(); ++p) sum_mean += mean[p], sum_var += var[p];
+    const double n = double(mean.size());
+    PilotFigures f;
+    const double mu = sum_mean / n;
+    f.sample_variance = sum_var / n;
+    f.relative_variance = mu > 0 ? f.sample_variance / (mu * mu) : 0.0;
+    f.seconds_per_sample = double(cpu_ns.load()) * 1e-9 / (n * K);
+    return f;
+}
+
+}  // namespace
+
+const std::vector<AutoCandidate> &auto_candidates() {
+    static const std::vector<AutoCandidate> candidates = {
+        {"nee", {}, [](const Scene &) { return true; }},
+        // Choices between lights by what each gives every voxel of the scene, without the map, then with
+        // it (NEE++'s visibility-aware selection, paper §3); the default light BVH knows bounds only.
+        {"light-spatial", {{"light_sampler", "spatial-oriented"}}, several_lights},
+        {"light-visibility", {{"light_sampler", "visibility"}}, several_lights},
+        // The map inside an environment light (sky through windows).
+        {"within-visibility", {{"within_light", "visibility"}}, has_environment},
+        // Shadow-ray roulette calibrated for least time × variance.
+        {"neepp-adaptive", {{"shadow_rays", "neepp-adaptive"}}, [](const Scene &) { return true; }},
+    };
+    return candidates;
+}
+
+AutoIntegrator::AutoIntegrator(std::vector<AutoCandidate> candidates, Make make)
+    : candidates_(std::move(candidates)), make_(std::move(make)) {
+    chosen_integrator_ = make_(candidates_.front());  // until prepare has measured
+}
+
+void AutoIntegrator::prepare(const Scene &scene) {
+    pilot_.clear();
+    // Plain NEE and the most efficient other candidate so far, prepared; the rest are dropped at once
+    // (each holds its own map).
+    std::unique_ptr<Integrator> nee, best;
+    double nee_efficiency = 0, best_efficiency = 0;
+    size_t best_k = 0;
+    // The map is seeded once, by the first candidate that seeds one in prepare; the others start from a
+    // copy of it, as it was before any of them learned.
+    std::optional<std::pair<VoxelGrid, VisibilityMap>> seeded;
+    for (size_t k = 0; k < candidates_.size(); ++k) {
+        if (!candidates_[k].applies(scene)) continue;
+        std::unique_ptr<Integrator> integrator = make_(candidates_[k]);
+        NeeppShadowRays *keeper = map_keeper(*integrator);
+        if (keeper && seeded) keeper->adopt_map(seeded->first, seeded->second);
+        // Prepared, then a first pilot pass that is not measured: what a candidate builds on first use
+        // (per-voxel tables) and what it decides after its first pass (whether to reject, the
+        // calibration, the map learned from its rays) are behind it, as they are for most of a render.
+        const auto t0 = std::chrono::steady_clock::now();
+        integrator->prepare(scene);
+        if (keeper && !seeded && keeper->map().pair_count() > 0) seeded.emplace(keeper->grid(), keeper->map());
+        const PilotFigures warm_up = run_pilot(scene, *integrator, 0);
+        integrator->end_pass(scene, PassStatistics{0, kPilotSpp, warm_up.sample_variance});
+        AutoPilotResult r;
+        r.name = candidates_[k].name;
+        r.prepare_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+        const PilotFigures f = run_pilot(scene, *integrator, kPilotSpp);
+        r.relative_variance = f.relative_variance;
+        r.seconds_per_sample = f.seconds_per_sample;
+        const double product = f.relative_variance * f.seconds_per_sample;
+        r.efficiency = product > 0 ? 1.0 / product : 0.0;
+        pilot_.push_back(r);
+        if (k == 0) {
+            nee_efficiency = r.efficiency;
+            nee = std::move(integrator);
+        } else if (r.efficiency > best_efficiency) {
+            best_efficiency = r.efficiency;
+            best_k = k;
+            best = std::move(integrator);
+        }
+    }
+    for (AutoPilotResult &r : pilot_) r.efficiency = nee_efficiency > 0 ? r.efficiency / nee_efficiency : 0.0;
+    const bool other = best && best_efficiency > kMargin * nee_efficiency;
+    chosen_ = other ? best_k : 0;
+    chosen_integrator_ = other ? std::move(best) : std::move(nee);
+    if (pilot_.size() == 1)
+        why_ = "no use of the visibility map applies to this scene";
+    else if (!other)
+        why_ = fmt::format("no candidate reached {:.2f}x plain NEE's efficiency in the pilot", kMargin);
+    else
+        why_ = fmt::format("{} had the best efficiency in the pilot, {:.2f}x plain NEE's (at least {:.2f}x needed)",
+                           picked(), best_efficiency / nee_efficiency, kMargin);
+}
+
+void AutoIntegrator::choose(const Scene &scene, size_t k) {
+    if (k == chosen_ && chosen_integrator_) return;
+    chosen_integrator_ = make_(candidates_[k]);
+    chosen_integrator_->prepare(scene);
+    chosen_ = k;
+}
+
+std::string AutoIntegrator::save_state() const { return picked() + '\n' + chosen().save_state(); }
+
+namespace {
+// (candidate name, the candidate's own state) of a saved state.
+std::pair<std::string, std::string> split_state(const std::string &state) {
+    const size_t nl = state.find('\n');
+    if (nl == std::string::npos) throw std::invalid_argument("neepp=auto: the saved integrator state has no candidate name");
+    return {state.substr(0, nl), state.substr(nl + 1)};
+}
+}  // namespace
+
+void AutoIntegrator::restore_state(const Scene &scene, const std::string &state) {
+    const auto [name, inner] = split_state(state);
+    size_t k = 0;
+    while (k < candidates_.size() && candidates_[k].name != name) ++k;
+    if (k == candidates_.size()) throw std::invalid_argument("neepp=auto: the saved state names no candidate ('" + name + "')");
+    if (k != chosen_) why_ = "continues the render that picked " + name;
+    choose(scene, k);
+    chosen().restore_state(scene, inner);
+}
+
+std::string AutoIntegrator::merge_states(const std::string &base, const std::vector<std::string> &learned) const {
+    if (learned.empty()) return base;
+    const std::string name = split_state(learned.front()).first;
+    std::vector<std::string> inner;
+    for (const std::string &s : learned) {
+        auto [n, in] = split_state(s);
+        if (n != name) throw std::invalid_argument("neepp=auto: the ranges picked different candidates");
+        inner.push_back(std::move(in));
+    }
+    const std::string base_inner = base.empty() ? std::string() : split_state(base).second;
+    return name + '\n' + chosen().merge_states(base_inner, inner);
+}
+
+nlohmann::json AutoIntegrator::describe() const {
+    nlohmann::json j = chosen().describe();
+    j["neepp"] = "auto";
+    j["neepp_picked"] = picked();
+    return j;
+}
+
+nlohmann::json AutoIntegrator::statistics() const {
+    nlohmann::json j = chosen().statistics();
+    nlohmann::json pilot = nlohmann::json::array();
+    for (const AutoPilotResult &r : pilot_)
+        pilot.push_back({{"candidate", r.name}, {"relative_variance", r.relative_variance},
+                         {"seconds_per_sample", r.seconds_per_sample}, {"efficiency_vs_nee", r.efficiency},
+                         {"prepare_s", r.prepare_s}});
+    j["neepp_auto"] = {{"picked", picked()}, {"why", why_}, {"pilot", pilot},
+                       {"pilot_pixels", "up to " + std::to_string(kPilotGrid) + "x" + std::to_string(kPilotGrid)},
+                       {"pilot_spp", kPilotSpp}, {"margin", kMargin}};
+    return j;
+}
+
+}  // namespace neepp
