@@ -1,6 +1,7 @@
 #!/usr/bin/env python3
 """Reproduce the NEE++ paper's tables: `nee` against each NEE++ shadow-ray policy of the path integrator,
-and against NEE++'s map used inside an environment light (configurations env-visibility, env-visibility-fitted).
+against NEE++'s map used inside an environment light (configurations env-visibility, env-visibility-fitted),
+and against `-I neepp=auto` (configuration auto).
 
 For every scene, at each sample count (default 4, 64, 1024) every policy renders the same scene with the
 same seed; the tables give, with ratios to `nee`: relMSE against the reference, shadow rays traced,
@@ -33,12 +34,13 @@ sys.path.insert(0, str(REPO / "python"))
 
 from neepp_tools import REFERENCES, SCENES_DIR, credit, exr, machine, metrics, report, runner  # noqa: E402
 
-POLICIES = ["nee", "neepp", "neepp-adaptive", "neepp-cv", "env-visibility"]
+POLICIES = ["nee", "neepp", "neepp-adaptive", "neepp-cv", "env-visibility", "auto"]
 # Configurations beyond a shadow-ray policy's name (any other name is passed as shadow_rays=NAME): NEE++'s
 # visibility map used inside an environment light (within_light), over the scene's grid or one fitted to
-# where the camera's paths shade.
+# where the camera's paths shade; and `neepp=auto`, which measures on a pilot which use pays.
 CONFIGS = {
     "nee": {},
+    "auto": {"neepp": "auto"},
     "env-visibility": {"within_light": "visibility"},
     "env-visibility-fitted": {"within_light": "visibility", "grid_bounds": "shading"},
 }

@@ -1,5 +1,6 @@
 // `-I neepp=auto`: which of NEE++'s uses pays on a scene is measured on it, not guessed. Each candidate
-// (plain NEE, and every use of the visibility map that applies to the scene) is prepared and renders the
+// (plain NEE, and each choice between lights by voxel, with and without the map, on scenes with several
+// lights) is prepared and renders the
 // same pilot: a few samples of pixels spread over the film, with the same random numbers. Its efficiency
 // is 1 / (relative variance per sample × CPU time per sample); the render goes on with the most efficient,
 // and with plain NEE unless another beats it by a margin, so that the pilot's own noise cannot pick a
@@ -38,7 +39,7 @@ public:
     AutoIntegrator(std::vector<AutoCandidate> candidates, Make make);
 
     // Efficiency a candidate must reach, relative to plain NEE, to be picked.
-    static constexpr double kMargin = 1.08;
+    static constexpr double kMargin = 1.15;
     // Pilot size: pixels on a grid of up to kPilotGrid × kPilotGrid, kPilotSpp samples each.
     static constexpr int kPilotGrid = 48;
     static constexpr int kPilotSpp = 8;

@@ -52,9 +52,9 @@ std::vector<IntegratorDoc> make_docs() {
     IntegratorDoc path{"path", "unidirectional path tracing with next event estimation and MIS (Mitsuba 3's path)",
                        common(p.max_depth, p.rr_depth, p.hide_emitters)};
     path.options.push_back({"neepp", "off",
-                            "off: the options below as given; auto: a pilot measures plain NEE and each use of the "
-                            "visibility map that applies (light_sampler=spatial-oriented or visibility, within_light=visibility, "
-                            "shadow_rays=neepp-adaptive) and renders with the most efficient (docs/neepp.md)", ""});
+                            "off: the options below as given; auto: with several lights, a pilot measures plain NEE, "
+                            "light_sampler=spatial-oriented and light_sampler=visibility, and renders with the most "
+                            "efficient (docs/neepp.md)", ""});
     path.options.push_back({"nee", text(p.nee), "next event estimation (false: BSDF sampling only, the paper's Path)", ""});
     path.options.push_back({"light_sampler", p.light_sampler, "which light NEE samples: " + samplers, ""});
     path.options.push_back({"within_light", p.within_light,
