@@ -345,8 +345,9 @@ nlohmann::json demo_pair(const std::string &dir, const std::string &scene, int s
 // The demo, three equal-time comparisons a first-time user can look at:
 //  1. shadow-ray rejection: the built-in door-ajar scene (a room lit through a door ajar) with plain NEE,
 //     then with NEE++'s best policy: more samples per pixel in the same time;
-//  2. light selection: the office scene (30 lights, most behind walls) with power-proportional light
-//     choice, then with NEE++'s visibility-aware choice: shadow rays spent on lights that are seen;
+//  2. light selection: the office scene (30 lights, most behind walls) with the default light choice (a
+//     light BVH), then with -I neepp=auto, which measures NEE++'s choices on a pilot and keeps the best:
+//     shadow rays spent on lights that are seen;
 //  3. BDPT's light-path selection: door-ajar with plain BDPT, then with NEE++ choosing, per camera path,
 //     which of a pool of light paths it connects to.
 void run_demo(const std::string &dir, int spp, bool quiet) {
@@ -354,8 +355,7 @@ void run_demo(const std::string &dir, int spp, bool quiet) {
     nlohmann::json rejection = demo_pair(dir, "door-ajar", spp, quiet, "nee", {"shadow_rays=nee"}, "neepp",
                                          {"shadow_rays=neepp-adaptive"},  // the best policy measured
                                          "demo_side_by_side.png");
-    nlohmann::json selection = demo_pair(dir, "office", spp, quiet, "lights_power", {"light_sampler=power"},
-                                         "lights_visibility", {"light_sampler=visibility"},
+    nlohmann::json selection = demo_pair(dir, "office", spp, quiet, "lights_bvh", {}, "lights_auto", {"neepp=auto"},
                                          "demo_lights_side_by_side.png");
     // BDPT costs several path samples per sample (every vertex pair is a connection): an eighth of the
     // sample count keeps the demo's time.
@@ -372,11 +372,11 @@ void run_demo(const std::string &dir, int spp, bool quiet) {
                    rejection["neepp"]["spp"].get<int>(), rejection["spp_ratio"].get<double>(),
                    rejection["shadow_rays_per_sample_ratio"].get<double>(), dir);
         fmt::print(stderr,
-                   "neepp demo: office, 30 lights, {:.2f} s each: {:.0f} % of power sampling's shadow rays were occluded, "
-                   "{:.0f} % of visibility-aware selection's; see {}/demo_lights_side_by_side.png (left power, right "
-                   "visibility)\n",
-                   selection["equal_time_s"].get<double>(), 100 * selection["occluded_fraction"]["lights_power"].get<double>(),
-                   100 * selection["occluded_fraction"]["lights_visibility"].get<double>(), dir);
+                   "neepp demo: office, 30 lights, {:.2f} s each: {:.0f} % of the light BVH's shadow rays were occluded, "
+                   "{:.0f} % of neepp=auto's ({}); see {}/demo_lights_side_by_side.png (left BVH, right auto)\n",
+                   selection["equal_time_s"].get<double>(), 100 * selection["occluded_fraction"]["lights_bvh"].get<double>(),
+                   100 * selection["occluded_fraction"]["lights_auto"].get<double>(),
+                   selection["lights_auto"]["integrator"].value("neepp_picked", std::string("?")), dir);
         fmt::print(stderr,
                    "neepp demo: door-ajar with BDPT, {:.2f} s each: {:.0f} % of plain BDPT's connections were occluded, "
                    "{:.0f} % with NEE++ light-path selection; see {}/demo_bdpt_side_by_side.png (left BDPT, right "

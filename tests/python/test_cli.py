@@ -265,7 +265,7 @@ def test_demo_writes_its_outputs(neepp_bin, tmp_path):
     r = run(neepp_bin, "demo", "-o", tmp_path / "demo", "--spp", 1, "--quiet", timeout=300)
     assert r.returncode == 0, r.stderr
     d = tmp_path / "demo"
-    for name in ("nee", "neepp", "lights_power", "lights_visibility", "bdpt", "bdpt_neepp"):
+    for name in ("nee", "neepp", "lights_bvh", "lights_auto", "bdpt", "bdpt_neepp"):
         for ext in ("exr", "png", "json"):
             assert (d / f"demo_{name}.{ext}").is_file(), f"demo_{name}.{ext} missing"
     for name in ("demo_side_by_side.png", "demo_lights_side_by_side.png", "demo_bdpt_side_by_side.png",
@@ -276,7 +276,9 @@ def test_demo_writes_its_outputs(neepp_bin, tmp_path):
     bdpt = summary["bdpt_light_path_selection"]
     assert bdpt["bdpt"]["integrator"]["name"] == "bdpt" and bdpt["bdpt_neepp"]["integrator"]["light_paths"] == "neepp"
     assert bdpt["bdpt"]["splats"] > 0
-    assert summary["light_selection"]["lights_visibility"]["integrator"]["light_sampler"] == "visibility"
+    auto = summary["light_selection"]["lights_auto"]
+    assert auto["integrator"]["neepp"] == "auto" and auto["integrator"]["neepp_picked"] in ("nee", "light-spatial", "light-visibility")
+    assert auto["integrator_statistics"]["neepp_auto"]["pilot"][0]["candidate"] == "nee"
 
 
 def test_version_and_list(neepp_bin):
