@@ -124,6 +124,33 @@ TEST(LightTracer, CorrectsForBumpMappedShadingNormals) {
     expect_same_image(ref, block_moments(path, "bdpt", Options(o), 6, 32, 1700), "bdpt, bump map");
 }
 
+// Lights at a point in view of the camera: a point light, and a spot light pointing away from it. No
+// camera sees them (Mitsuba's ptracer never connects delta emitters to the sensor; camera paths cannot
+// hit them), only the floor they light. Light tracing used to connect their own position to the camera
+// and splat their intensity, unshaped by the spot's cone, onto the pixel each projects to: pixels of
+// ~1000 in Mitsuba's various_emitters scene, three times its image mean.
+std::string lights_at_points_in_view_scene() {
+    return write_temp_scene(R"(<scene version="3.0.0">
+  <sensor type="perspective">
+    <float name="fov" value="60"/>
+    <transform name="to_world"><lookat origin="0,1.5,4" target="0,0.8,0" up="0,1,0"/></transform>
+    <film type="hdrfilm"><integer name="width" value="24"/><integer name="height" value="18"/><rfilter type="box"/></film>
+  </sensor>
+  <shape type="rectangle"><transform name="to_world"><scale value="3"/><rotate x="1" angle="-90"/></transform>
+    <bsdf type="diffuse"><rgb name="reflectance" value="0.6"/></bsdf></shape>
+  <emitter type="point"><point name="position" x="-0.8" y="1" z="0"/><rgb name="intensity" value="2"/></emitter>
+  <emitter type="spot"><rgb name="intensity" value="4"/><float name="cutoff_angle" value="30"/>
+    <transform name="to_world"><lookat origin="0.8,1.2,0" target="0.8,0,0" up="0,0,1"/></transform></emitter>
+</scene>)");
+}
+
+TEST(LightTracer, NoCameraSeesALightAtAPoint) {
+    const std::string path = lights_at_points_in_view_scene();
+    const BlockMoments ref = block_moments(path, "path", Options(), 6, 32, 1800);
+    expect_same_image(ref, block_moments(path, "light", Options(), 6, 32, 1900), "light tracing, point and spot light in view");
+    expect_same_image(ref, block_moments(path, "bdpt", Options(), 6, 16, 2000), "bdpt, point and spot light in view");
+}
+
 // NEE++ selection is unbiased whatever the map says: planted "never visible" for every pair, with
 // learning off, so the selection leans on wrong scores for the whole render.
 RenderedImage render_bdpt_with_wrong_map(const std::string &path, int spp, uint64_t seed) {

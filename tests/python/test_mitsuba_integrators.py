@@ -1,7 +1,8 @@
 """A scene that names one of Mitsuba 3's integrators renders, in neepp, the image Mitsuba 3 renders with
 it: volpath and volpathmis (no media) as path, direct as path with max_depth 2 (a glossy room where the second
-bounce is a third of the light, so a wrong depth shows). Image means within 1.5 % plus 4 standard errors. (prb maps to path too; Mitsuba has it only in its
-differentiable variants, which this test does not start.)"""
+bounce is a third of the light, so a wrong depth shows), aov as the integrator it nests (its RGB image; the
+AOV channels are not written). Image means within 1.5 % plus 4 standard errors. (prb maps to path too;
+Mitsuba has it only in its differentiable variants, which this test does not start.)"""
 from __future__ import annotations
 
 import subprocess
@@ -34,6 +35,9 @@ SCENE = """<scene version="3.0.0">
     ("direct", ""),
     ("volpathmis", '<integer name="max_depth" value="4"/>'),
     ("volpath", '<integer name="max_depth" value="3"/>'),
+    # aov's image is its nested integrator's (the AOV channels neepp does not write).
+    ("aov", '<string name="aovs" value="dd.y:depth, nn:sh_normal"/>'
+            '<integrator type="path" name="image"><integer name="max_depth" value="3"/></integrator>'),
 ])
 def test_scene_integrator_renders_as_in_mitsuba(mitsuba_type, options, tmp_path, neepp_bin):
     xml = tmp_path / "scene.xml"
@@ -43,11 +47,12 @@ def test_scene_integrator_renders_as_in_mitsuba(mitsuba_type, options, tmp_path,
     OUT.mkdir(parents=True, exist_ok=True)
     code = ("import os, mitsuba as mi; mi.set_variant('scalar_rgb'); "
             f"img = mi.render(mi.load_file({str(xml)!r}), spp=256, seed=2); "
-            f"mi.Bitmap(img).write({str(out)!r}); os._exit(0)")
+            f"import numpy as np; mi.Bitmap(np.array(img)[..., :3]).write({str(out)!r}); os._exit(0)")  # aov: + AOVs
     subprocess.run([runner.mitsuba_python(), "-c", code], check=True, timeout=300)
     ref = exr.read_exr(out)
     r = runner.run_neepp(xml, OUT / f"neepp_{mitsuba_type}.exr", spp=256, seed=2, binary=neepp_bin)
     assert "renders here as 'path'" in r.log, r.log
+    assert (mitsuba_type == "aov") == ("not written: 'aov': the AOV channels (dd.y:depth, nn:sh_normal)" in r.log), r.log
     m, mr = metrics.image_mean(r.image), metrics.image_mean(ref)
     se = metrics.mean_stderr(r.image, ref)
     assert abs(m - mr) < 4 * se + 0.015 * mr, (mitsuba_type, m, mr, se)

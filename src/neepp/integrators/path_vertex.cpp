@@ -9,7 +9,11 @@ namespace neepp {
 bool PathVertex::connectible() const {
     switch (kind) {
     case VertexKind::Camera: return true;
-    case VertexKind::Light: return !infinite;
+    // A light at a point (point, spot, projector) is a delta in position: no camera sees it, as no camera
+    // path can hit it (Mitsuba's ptracer never connects delta emitters to the sensor, and its path tracer
+    // and neepp's never find them). Connecting one to the camera would splat its intensity, unshaped by
+    // its emission profile, onto the pixel it projects to.
+    case VertexKind::Light: return !infinite && !(light && light->is_delta());
     case VertexKind::Surface: return (si.shape->bsdf_flags & BSDFSmooth) != 0;
     }
     return false;
@@ -51,7 +55,7 @@ Color scatter(const PathVertex &v, const Vec3 &w) {
     switch (v.kind) {
     case VertexKind::Camera: return Color(0.f);
     case VertexKind::Light:
-        if (v.infinite || !v.on_surface()) return Color(1.f);
+        if (v.infinite || !v.on_surface()) return Color(0.f);
         return dot(v.si.sh_frame.n, w) > 0 ? Color(std::abs(dot(v.n, w))) : Color(0.f);
     case VertexKind::Surface: {
         const SurfaceInteraction &si = v.si;

@@ -35,7 +35,8 @@ struct PathVertex {
 
     bool on_surface() const { return n.x != 0.f || n.y != 0.f || n.z != 0.f; }
     // Whether a strategy may connect to this vertex: a delta BSDF (mirror, glass) has no density to
-    // evaluate, nor has a vertex on an infinite light a position to aim a connection at.
+    // evaluate, a vertex on an infinite light has no position to aim a connection at, and a light at a
+    // point is seen by no camera.
     bool connectible() const;
     // Emits (a light endpoint, or a surface vertex on an area light).
     bool is_light() const { return kind == VertexKind::Light || (kind == VertexKind::Surface && light); }
@@ -59,7 +60,8 @@ Vec3 direction_between(const PathVertex &a, const PathVertex &b);
 float solid_angle_to_area(float pdf, const PathVertex &from, const PathVertex &to);
 // f·|cos| at v toward direction w (world): the BSDF for surface vertices (with Veach's shading-normal
 // correction on light subpaths); for light endpoints the emission's direction factor (|cos| on the
-// emitting side of an area light, 1 for a point light), Le being in beta.
+// emitting side of an area light), Le being in beta. Only connectible vertices are asked: a light at a
+// point or at infinity gets zero.
 Color scatter(const PathVertex &v, const Vec3 &w);
 // Radiance a camera-path vertex on an emitter sends toward the previous vertex (the s = 0 strategy).
 Color emitted_toward(const BidirContext &ctx, const PathVertex &v, const PathVertex &prev);

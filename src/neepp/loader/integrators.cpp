@@ -1,6 +1,8 @@
+#include <algorithm>
 #include <set>
 #include <fmt/core.h>
 #include "neepp/loader/factories.h"
+#include "neepp/loader/supported_plugins.h"
 
 namespace neepp::loader {
 
@@ -39,24 +41,90 @@ const std::map<std::string, Mapping> &mitsuba_integrators() {
     return m;
 }
 
-// Integrators that only wrap another and change what is output beside its image (moment adds the
-// second moment as extra channels): the image is the nested integrator's.
-const std::set<std::string> kWrappers = {"moment"};
+// Integrators that wrap others and write more beside the image, which is their first nested
+// integrator's (Mitsuba makes it their RGB image): moment adds the second moments of each nested
+// integrator, aov arbitrary output variables of the visible surfaces. neepp writes the image only.
+// Mitsuba nests sampling integrators only: ptracer (which splats) it refuses. Each with what it writes
+// beside the image.
+const std::map<std::string, std::string> kWrappers = {
+    {"moment", "the second-moment channels"},
+    {"aov", "the AOV channels"},
+};
+
+// The AOV types of Mitsuba's aov integrator (src/integrators/aov.cpp).
+const std::set<std::string> kAovTypes = {"albedo",     "depth",     "position", "uv",     "geo_normal", "sh_normal",
+                                         "dp_du",      "dp_dv",     "duv_dx",   "duv_dy", "prim_index", "shape_index"};
+
+// The aov integrator's `aovs` string, "name:type" pairs separated by commas or spaces, checked as Mitsuba
+// checks it (it refuses the integrator without one, or with an unknown type): the pairs, for the note.
+std::vector<std::string> aov_channels(const XmlNode &aov) {
+    if (!aov.has("aovs"))
+        throw aov.error("the 'aov' integrator needs its string 'aovs' (\"name:type, ...\"), as in Mitsuba");
+    const std::string spec = aov.get_string("aovs");
+    std::vector<std::string> pairs;
+    size_t i = 0;
+    while ((i = spec.find_first_not_of(", ", i)) != std::string::npos) {
+        const size_t end = spec.find_first_of(", ", i);
+        const std::string pair = spec.substr(i, end == std::string::npos ? std::string::npos : end - i);
+        i = end;
+        const size_t colon = pair.find(':');
+        if (colon == 0 || colon == std::string::npos || pair.find(':', colon + 1) != std::string::npos)
+            throw aov.error("'aovs': '" + pair + "' is not a name:type pair");
+        if (!kAovTypes.count(pair.substr(colon + 1))) {
+            std::string types;
+            for (const std::string &t : kAovTypes) types += (types.empty() ? "" : ", ") + t;
+            throw aov.error("'aovs': unknown AOV type '" + pair.substr(colon + 1) + "' in '" + pair + "' (Mitsuba's: " +
+                            types + ")");
+        }
+        pairs.push_back(pair);
+    }
+    return pairs;
+}
+
+// The integrator a wrapper takes its image from, and a clause naming what it writes that neepp does not.
+const XmlNode &unwrap(const XmlNode &wrapper, std::string &not_written) {
+    std::vector<std::pair<const XmlNode *, std::string>> nested;  // with the name each was given
+    for (size_t k = 0; k < wrapper.children.size(); ++k)
+        if (wrapper.children[k]->tag == "integrator")
+            nested.push_back({wrapper.children[k].get(), wrapper.child_names[k]});
+    const std::string &extra = kWrappers.at(wrapper.type);
+    std::string what = extra;
+    if (wrapper.type == "aov") {
+        std::string channels;
+        for (const std::string &c : aov_channels(wrapper)) channels += (channels.empty() ? "" : ", ") + c;
+        if (!channels.empty()) what += " (" + channels + ")";
+    }
+    for (auto &[name, prop] : wrapper.props) prop.used = true;  // its options shape its extra outputs only
+    if (nested.empty())
+        throw wrapper.error("the '" + wrapper.type + "' integrator nests no integrator: Mitsuba's image is then black, "
+                            "beside " + extra + ", which neepp does not write; nest the integrator that renders "
+                            "the image (e.g. <integrator type=\"path\"/>)");
+    for (const auto &[n, name] : nested)
+        if (n->type == "ptracer")
+            throw n->error("Mitsuba's '" + wrapper.type + "' integrator nests sampling integrators only, not 'ptracer' "
+                           "(render the scene with ptracer alone)");
+    if (nested.size() > 1) {
+        std::string others;
+        for (size_t k = 1; k < nested.size(); ++k)
+            others += (others.empty() ? "'" : ", '") + (nested[k].second.empty() ? nested[k].first->type : nested[k].second) + "'";
+        what += " and the images of its other nested integrators (" + others + ")";
+    }
+    not_written += (not_written.empty() ? "" : "; ") + ("'" + wrapper.type + "': " + what);
+    return *nested[0].first;
+}
 
 }  // namespace
 
 void load_integrator(const XmlNode &node, RenderSettings &settings) {
     const XmlNode *n = &node;
-    std::string chain;
+    std::string chain, not_written;
     while (kWrappers.count(n->type)) {
-        const auto nested = n->children_with_tag("integrator");
-        if (nested.size() != 1)
-            throw n->error("the '" + n->type + "' integrator wraps one integrator here, found " +
-                           std::to_string(nested.size()));
         chain += "'" + n->type + "' around ";
-        for (auto &[name, prop] : n->props) prop.used = true;  // its own options shape its extra outputs only
-        n = nested[0].get();
+        n = &unwrap(*n, not_written);
     }
+    const std::vector<std::string> &known = supported_names("integrator");
+    if (std::find(known.begin(), known.end(), n->type) == known.end())
+        throw n->error("unsupported integrator '" + n->type + "' (supported: " + supported_list("integrator") + ")");
     settings.integrator = n->type;
     settings.integrator_options.clear();
     const auto mapped = mitsuba_integrators().find(n->type);
@@ -82,9 +150,10 @@ void load_integrator(const XmlNode &node, RenderSettings &settings) {
     }
     std::string ignored;
     for (const std::string &d : dropped) ignored += (ignored.empty() ? "" : ", ") + d;
-    fmt::print(stderr, "neepp: note: {}:{}: Mitsuba's integrator {}'{}' renders here as '{}'{}, the same image{}\n",
+    fmt::print(stderr, "neepp: note: {}:{}: Mitsuba's integrator {}'{}' renders here as '{}'{}, the same image{}{}\n",
                node.file, node.line, chain, n->type, settings.integrator, how,
-               ignored.empty() ? "" : " (" + ignored + " change only the noise: ignored)");
+               ignored.empty() ? "" : " (" + ignored + " change only the noise: ignored)",
+               not_written.empty() ? "" : "; not written: " + not_written);
 }
 
 }  // namespace neepp::loader

@@ -20,7 +20,7 @@ const std::vector<std::pair<std::string, std::vector<std::string>>> &supported_p
         {"sampler", {"independent", "sobol", "stratified", "multijitter", "ldsampler", "orthogonal"}},
         // Mitsuba 3's integrators, each rendered by neepp's own that gives the same image (loader/integrators.cpp).
         {"integrator", {"path", "bdpt", "light", "pssmlt", "prb", "prb_basic", "volpath", "volpathmis", "direct",
-                        "ptracer", "moment"}},
+                        "ptracer", "moment", "aov"}},
     };
     return plugins;
 }
