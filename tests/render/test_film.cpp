@@ -93,3 +93,21 @@ TEST(ImageBlock, PixelsHoldTheFilterWeightedMeanOfTheirSamples) {
         EXPECT_GT(lit, 4) << name;
     }
 }
+
+// A box filter's pixels are half-open, [i, i + 1): a splat exactly on a pixel boundary adds its value
+// once, to the pixel on its right (a splat film is not normalized by weights, so counting it in both
+// pixels would add its energy twice: the light tracer's point lights once did).
+TEST(SplatFilm, ABoxSplatOnAPixelBoundaryCountsOnce) {
+    ReconstructionFilter box("box", 0.5f, 0.5f);
+    SplatFilm film(4, 3, &box);
+    ASSERT_TRUE(film.add(2.0f, 1.0f, Color(1.f)));
+    const Image img = film.resolve(1.0);
+    double sum = 0;
+    for (int y = 0; y < 3; ++y)
+        for (int x = 0; x < 4; ++x) {
+            const float v = img.data[3 * (size_t(y) * 4 + x)];
+            sum += v;
+            EXPECT_EQ(v, x == 2 && y == 1 ? 1.f : 0.f) << "pixel " << x << "," << y;
+        }
+    EXPECT_DOUBLE_EQ(sum, 1.0);
+}

@@ -5,6 +5,13 @@
 
 namespace neepp {
 
+namespace {
+// The first pixel a sample at p reaches: its centre c = i + 0.5 must satisfy c - p > -r, strictly, so
+// that a box filter's pixels are half-open, [i, i + 1), as Mitsuba's: a sample (or a splat, which is not
+// normalized by the weights) exactly on a pixel boundary counts once, not in both pixels.
+inline int first_pixel(float p, float r) { return int(std::floor(p - 0.5f - r)) + 1; }
+}  // namespace
+
 ReconstructionFilter::ReconstructionFilter(const std::string &type, float radius, float stddev)
     : radius_(radius), inv_radius_(1.f / radius), stddev_(stddev) {
     if (type == "box") type_ = Type::Box;
@@ -40,8 +47,9 @@ void SplatFilm::clear() {
 bool SplatFilm::add(float px, float py, const Color &L) {
     if (!is_finite(L) || !(std::isfinite(px) && std::isfinite(py))) return false;
     const float r = filter_->radius();
-    const int ix0 = std::max(0, int(std::ceil(px - 0.5f - r))), ix1 = std::min(width_ - 1, int(std::floor(px - 0.5f + r)));
-    const int iy0 = std::max(0, int(std::ceil(py - 0.5f - r))), iy1 = std::min(height_ - 1, int(std::floor(py - 0.5f + r)));
+    // Pixels whose centre c satisfies -r < c - p <= r (see first_pixel).
+    const int ix0 = std::max(0, first_pixel(px, r)), ix1 = std::min(width_ - 1, int(std::floor(px - 0.5f + r)));
+    const int iy0 = std::max(0, first_pixel(py, r)), iy1 = std::min(height_ - 1, int(std::floor(py - 0.5f + r)));
     if (std::max({std::abs(L.x), std::abs(L.y), std::abs(L.z)}) * inv_integral_ > kMaxValue) return false;
     for (int y = iy0; y <= iy1; ++y) {
         const float wy = filter_->eval(float(y) + 0.5f - py) * inv_integral_;
@@ -101,9 +109,9 @@ typedef double Sums4 __attribute__((vector_size(32), aligned(8), may_alias));
 
 void ImageBlock::put(float px, float py, const Color &L) {
     float r = filter_->radius();
-    // Pixels whose centre (i + 0.5) lies within the radius of the sample.
-    int ix0 = std::max(x0_, int(std::ceil(px - 0.5f - r))), ix1 = std::min(x0_ + width_ - 1, int(std::floor(px - 0.5f + r)));
-    int iy0 = std::max(y0_, int(std::ceil(py - 0.5f - r))), iy1 = std::min(y0_ + height_ - 1, int(std::floor(py - 0.5f + r)));
+    // Pixels whose centre (i + 0.5) lies within the radius of the sample (see first_pixel).
+    int ix0 = std::max(x0_, first_pixel(px, r)), ix1 = std::min(x0_ + width_ - 1, int(std::floor(px - 0.5f + r)));
+    int iy0 = std::max(y0_, first_pixel(py, r)), iy1 = std::min(y0_ + height_ - 1, int(std::floor(py - 0.5f + r)));
     float wx[40], wy[40];
     int nx = ix1 - ix0 + 1, ny = iy1 - iy0 + 1;
     if (nx <= 0 || ny <= 0 || nx > 40 || ny > 40) return;
