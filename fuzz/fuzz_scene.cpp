@@ -1,12 +1,13 @@
 // The scene loader on arbitrary XML: parsing (pugixml, then Mitsuba's elements: defaults, -D
 // substitution, includes, refs, transforms), every plugin's parameters, and building the scene (meshes,
-// textures, lights, the BVH). The input is written beside a small OBJ, PLY, .serialized and PNG, so that files it
-// names can be found. The first line, when it starts with "-D ", holds name=value parameter overrides
+// textures, lights, the BVH). The input is written beside a small OBJ, PLY, .serialized, .vol and PNG, so that
+// files it names can be found. The first line, when it starts with "-D ", holds name=value parameter overrides
 // (as the CLI's -D), to fuzz their substitution too.
 #include <exception>
 #include <map>
 #include <sstream>
 #include "common/serialized_writer.h"
+#include "common/volume_grid_writer.h"
 #include "fuzz_input.h"
 #include "neepp/io/image.h"
 #include "neepp/loader/scene_loader.h"
@@ -25,6 +26,8 @@ void write_companions() {
     tri.indices = {0, 1, 2};
     const std::string serialized = neepp::testing::serialized({tri, tri});
     neepp::fuzz::write_input(reinterpret_cast<const uint8_t *>(serialized.data()), serialized.size(), "mesh.serialized");
+    const std::string grid = neepp::testing::volume_grid_bytes(neepp::testing::sphere_sdf_grid(5));
+    neepp::fuzz::write_input(reinterpret_cast<const uint8_t *>(grid.data()), grid.size(), "grid.vol");
     neepp::write_png_srgb((neepp::fuzz::scratch_dir() / "texture.png").string(), neepp::Image(2, 2, 3));
 }
 
@@ -51,7 +54,9 @@ extern "C" int LLVMFuzzerInitialize(int *, char ***) {
             "<scene version='3.0.0'><sensor type='perspective'><film type='hdrfilm'><integer name='width' value='8'/>"
             "<integer name='height' value='8'/></film></sensor>"
             "<shape type='shapegroup' id='group'><shape type='serialized'><string name='filename' value='mesh.serialized'/>"
-            "<integer name='shape_index' value='1'/><bsdf type='diffuse'/></shape><shape type='sphere'/></shape>"
+            "<integer name='shape_index' value='1'/><bsdf type='diffuse'/></shape><shape type='sphere'/>"
+            "<shape type='sdfgrid'><string name='filename' value='grid.vol'/><string name='normals' value='analytic'/>"
+            "</shape></shape>"
             "<shape type='instance'><ref id='group'/></shape>"
             "<shape type='instance'><ref id='group'/><transform name='to_world'><translate x='2'/></transform></shape>"
             "<emitter type='constant'/></scene>\n");

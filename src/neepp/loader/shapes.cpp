@@ -4,6 +4,7 @@
 #include "neepp/io/obj_reader.h"
 #include "neepp/io/ply_reader.h"
 #include "neepp/io/serialized_reader.h"
+#include "neepp/io/volume_grid_reader.h"
 #include "neepp/lights/area_light.h"
 #include "neepp/lights/environment_light.h"
 #include "neepp/lights/directional_light.h"
@@ -13,6 +14,7 @@
 #include "neepp/loader/factories.h"
 #include "neepp/loader/problems.h"
 #include "neepp/materials/bitmap_texture.h"
+#include "neepp/scene/sdf_grid.h"
 
 namespace neepp::loader {
 namespace {
@@ -114,6 +116,31 @@ Transform cylinder_frame(const XmlNode &node) {
     return Transform(m);
 }
 
+// Mitsuba's `sdfgrid`: the single-channel grid of a .vol file over [0, 1]^3 (the file's own bounds are not
+// used, as in Mitsuba), with its `normals` option.
+std::shared_ptr<const SdfGrid> load_sdf_grid(const XmlNode &node) {
+    const std::string normals = node.get_string("normals", "smooth");
+    if (normals != "smooth" && normals != "analytic")
+        throw node.error("sdfgrid normals must be \"smooth\" or \"analytic\", not \"" + normals + "\"");
+    // Mitsuba's other source, a `grid` tensor, can be given from Python or C++ only, never in XML.
+    if (!node.has("filename")) throw node.error("an sdfgrid needs a 'filename': its grid as a .vol file");
+    const std::string path = node.resolve_path(node.get_string("filename"));
+    try {  // the file's own error, located at the shape using it
+        VolumeGrid grid = read_volume_grid(path);
+        if (grid.channels != 1)
+            throw SceneError(path, "an sdfgrid's grid has " + std::to_string(grid.channels) + " channels, expected 1");
+        try {
+            return std::make_shared<const SdfGrid>(grid.size[0], grid.size[1], grid.size[2], std::move(grid.values),
+                                                   normals == "smooth" ? SdfGrid::Normals::Smooth
+                                                                       : SdfGrid::Normals::Analytic);
+        } catch (const std::invalid_argument &e) {
+            throw SceneError(path, e.what());
+        }
+    } catch (const std::exception &e) {
+        throw node.error(e.what());
+    }
+}
+
 // Smooth vertex normals for meshes that have none, weighting each face by its angle at the vertex
 // (Mitsuba's recompute_vertex_normals).
 void compute_vertex_normals(Shape &s) {
@@ -143,8 +170,16 @@ void compute_vertex_normals(Shape &s) {
 
 // Moves the shape's mesh or sphere by `to_world`: a mesh's vertex normals keep their direction
 // relative to the surface (the inverse transpose, renormalized). A to_world on a sphere may translate,
-// rotate, mirror and scale uniformly, its axes turning with it (Mitsuba allows more; neepp refuses).
+// rotate, mirror and scale uniformly, its axes turning with it (Mitsuba allows more; neepp refuses). An
+// SDF grid takes any affine to_world: rays go to its space.
 void transform_shape(Shape &s, const Transform &to_world) {
+    if (s.kind == Shape::Kind::SdfGrid) {
+        s.sdf_to_world = to_world * s.sdf_to_world;
+        for (const auto &row : s.sdf_to_world.matrix.m)
+            for (float v : row)
+                if (!std::isfinite(v)) throw std::runtime_error("the sdfgrid's to_world is not finite");
+        return;
+    }
     if (s.kind == Shape::Kind::Sphere) {
         Vec3 axes[3];
         float scale[3];
@@ -190,7 +225,7 @@ void set_mesh(Shape &s, MeshData mesh, const Transform &to_world) {
 // collinear vertices), has none, and an emitter on it would be a light of zero area, which neither
 // light sampling nor emission sampling can sample a point of.
 bool has_surface(const Shape &s) {
-    if (s.kind == Shape::Kind::Sphere) return true;
+    if (s.kind != Shape::Kind::Mesh) return true;
     for (size_t t = 0; t + 2 < s.indices.size(); t += 3) {
         const Vec3 &a = s.positions[s.indices[t]];
         if (norm(cross(s.positions[s.indices[t + 1]] - a, s.positions[s.indices[t + 2]] - a)) > 0) return true;
@@ -215,6 +250,8 @@ void Factories::shape(const XmlNode &node, Scene &scene) {
     scene.add_shape(std::move(s));
     if (emitter_node) attempt([&] {
         if (emitter_node->type != "area") throw emitter_node->error("a shape can only carry an 'area' emitter");
+        if (shape->kind == Shape::Kind::SdfGrid)
+            throw emitter_node->error("an sdfgrid cannot carry an area emitter (Mitsuba 3's sdfgrid cannot be an emitter)");
         TexturePtr radiance = texture_param(*emitter_node, "radiance", Color(1.f));
         warn_unused(*emitter_node);
         if (!has_surface(*shape)) {
@@ -229,10 +266,13 @@ void Factories::shape(const XmlNode &node, Scene &scene) {
 std::unique_ptr<Shape> Factories::build_shape(const XmlNode &node, const XmlNode *&emitter_node) {
     auto s = std::make_unique<Shape>();
     s->id = node.id;
-    s->face_normals = node.get_bool("face_normals", false);
-    s->flip_normals = node.get_bool("flip_normals", false);
-    Transform to_world = node.get_transform("to_world");
     const std::string &t = node.type;
+    // Mitsuba's sdfgrid has neither option: left unread, either is reported as unused.
+    if (t != "sdfgrid") {
+        s->face_normals = node.get_bool("face_normals", false);
+        s->flip_normals = node.get_bool("flip_normals", false);
+    }
+    Transform to_world = node.get_transform("to_world");
     try {
         if (t == "obj" || t == "ply" || t == "serialized") {
             std::string path = node.resolve_path(node.get_string("filename"));
@@ -257,6 +297,10 @@ std::unique_ptr<Shape> Factories::build_shape(const XmlNode &node, const XmlNode
             s->center = node.get_vector("center", Vec3(0.f));
             s->radius = node.get_float("radius", 1.f);
             if (!(s->radius > 0) || !std::isfinite(s->radius)) throw node.error("sphere radius must be positive and finite");
+            transform_shape(*s, to_world);
+        } else if (t == "sdfgrid") {
+            s->kind = Shape::Kind::SdfGrid;
+            s->sdf_grid = load_sdf_grid(node);
             transform_shape(*s, to_world);
         } else {
             throw node.error("unsupported shape type '" + t + "' (supported: " + supported_list("shape") + ")");

@@ -8,6 +8,7 @@
 #include <type_traits>
 
 #include "neepp/math/transpose.h"
+#include "neepp/scene/embree_sdf_grid.h"
 
 namespace neepp {
 namespace {
@@ -189,6 +190,8 @@ void Scene::build() {
             float *v = (float *)rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT4,
                                                         4 * sizeof(float), 1);
             v[0] = s.center.x; v[1] = s.center.y; v[2] = s.center.z; v[3] = s.radius;
+        } else if (s.kind == Shape::Kind::SdfGrid) {
+            geom = new_sdf_grid_geometry(device_, s);
         } else {
             if (s.indices.empty()) continue;  // nothing to intersect; kept so ids stay stable
             geom = rtcNewGeometry(device_, RTC_GEOMETRY_TYPE_TRIANGLE);

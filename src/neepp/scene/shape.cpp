@@ -5,6 +5,7 @@
 #include <cmath>
 
 #include "neepp/math/warp.h"
+#include "neepp/scene/sdf_grid.h"
 
 namespace neepp {
 
@@ -17,6 +18,11 @@ void Shape::finalize() {
     lane_has_uv_ = uvs.empty() ? 0.f : all_bits;
     if (kind == Kind::Sphere) {
         area_ = 4.f * kPi * radius * radius;
+        return;
+    }
+    if (kind == Kind::SdfGrid) {
+        area_ = 0;  // as Mitsuba's: nothing samples a point on it
+        sdf_to_object_ = sdf_to_world.inverse();
         return;
     }
     std::vector<float> areas(triangle_count());
@@ -94,6 +100,8 @@ BBox Shape::bounds() const {
     if (kind == Kind::Sphere) {
         b.expand(center - Vec3(radius));
         b.expand(center + Vec3(radius));
+    } else if (kind == Kind::SdfGrid) {
+        for (int k = 0; k < 8; ++k) b.expand(sdf_to_world.point(Vec3(float(k & 1), float(k >> 1 & 1), float(k >> 2 & 1))));
     } else {
         for (const Vec3 &p : positions) b.expand(p);
     }
@@ -174,6 +182,7 @@ void Shape::fill_interaction(uint32_t prim, float b1, float b2, const Ray &ray, 
         }
         return;
     }
+    if (kind == Kind::SdfGrid) return fill_sdf_interaction(ray, t, si);
     const HitTriangle &tri = hit_triangles_[prim];
     const Vec3 &p0 = tri.p[0], &p1 = tri.p[1], &p2 = tri.p[2];
     float b0 = 1.f - b1 - b2;
@@ -218,6 +227,23 @@ void Shape::fill_interaction(uint32_t prim, float b1, float b2, const Ray &ray, 
     } else {
         si.sh_frame = Frame(ns);
     }
+}
+
+// As Mitsuba's sdfgrid: the point on the ray; the geometric normal the gradient of the hit voxel's
+// interpolant, the shading normal by the grid's `normals` option, both moved by to_world as normals are.
+void Shape::fill_sdf_interaction(const Ray &ray, float t, SurfaceInteraction &si) const {
+    si.p = ray.at(t);
+    const Vec3 local = sdf_to_object_.point(si.p);
+    // A gradient of zero (a flat spot of a degenerate grid) has no direction: the side the ray came from.
+    auto world_normal = [&](const Vec3 &n, const Vec3 &fallback) {
+        const Vec3 w = sdf_to_world.normal(n);
+        const float len = norm(w);
+        return len > 0 && std::isfinite(len) ? w / len : fallback;
+    };
+    si.n = world_normal(sdf_grid->gradient(local), -normalize(ray.d));
+    si.sh_frame = Frame(world_normal(sdf_grid->shading_normal(local), si.n));
+    si.uv = Vec2(0.f, 0.f);
+    si.dpdu = si.dpdv = Vec3(0.f);
 }
 
 }  // namespace neepp

@@ -1,5 +1,5 @@
-// A shape of the scene: a triangle mesh in world space (or an analytic sphere), its material, and the
-// area light it carries if it emits.
+// A shape of the scene: a triangle mesh in world space (or an analytic sphere, or an SDF grid), its
+// material, and the area light it carries if it emits.
 #pragma once
 #include <memory>
 #include <optional>
@@ -9,11 +9,13 @@
 #include "neepp/materials/bsdf.h"
 #include "neepp/math/bbox.h"
 #include "neepp/math/distribution.h"
+#include "neepp/math/transform.h"
 #include "neepp/scene/interaction.h"
 
 namespace neepp {
 
 class Light;
+class SdfGrid;
 
 struct PositionSample {
     Vec3 p, n;      // point on the surface and its geometric normal
@@ -23,7 +25,7 @@ struct PositionSample {
 };
 
 struct Shape {
-    enum class Kind { Mesh, Sphere };
+    enum class Kind { Mesh, Sphere, SdfGrid };
     Kind kind = Kind::Mesh;
     std::string id;
 
@@ -41,6 +43,14 @@ struct Shape {
     Vec3 center;
     float radius = 0;
     Vec3 sphere_axes[3] = {{1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
+
+    // SDF grid data: the grid in its own space [0, 1]^3 (shared by the instances of one shape) and where
+    // to_world puts it. Embree intersects it through callbacks (scene/embree_sdf_grid.cpp); it has no
+    // area (Mitsuba's sdfgrid cannot emit) and no uv (0, 0 as in Mitsuba).
+    std::shared_ptr<const SdfGrid> sdf_grid;
+    Transform sdf_to_world;
+    // sdf_to_world's inverse, which every ray against the grid goes through; set by finalize().
+    const Transform &sdf_to_object() const { return sdf_to_object_; }
 
     BSDFPtr bsdf;
     const Light *area_light = nullptr;  // set when the scene creates an area light for this shape
@@ -124,7 +134,7 @@ struct Shape {
     // Cache prefetch of what fill_interaction(prim) reads: its triangle's record, two cache lines.
     // Inline: it runs once per ray, from the integrator's batch loop.
     void prefetch(uint32_t prim) const {
-        if (kind == Kind::Sphere) return;
+        if (kind != Kind::Mesh) return;
         const char *record = reinterpret_cast<const char *>(&hit_triangles_[prim]);
         __builtin_prefetch(record);
         __builtin_prefetch(record + sizeof(HitTriangle) - 1);
@@ -150,8 +160,11 @@ private:
     };
     SamplingTriangle sampling_triangle(size_t tri) const;
     std::optional<Parallelogram> find_parallelogram() const;
+    // fill_interaction of an SDF grid: Mitsuba's normals at the hit, no uv or dp/du.
+    void fill_sdf_interaction(const Ray &ray, float t, SurfaceInteraction &si) const;
 
     float lane_flip_ = 0, lane_vertex_normals_ = 0, lane_has_uv_ = 0;  // HitLanes' masks, set by finalize()
+    Transform sdf_to_object_;
     float area_ = 0;
     Distribution1D triangle_distribution_;
     std::vector<SamplingTriangle> sampling_triangles_;  // precomputed for emitters (sampled at every NEE)

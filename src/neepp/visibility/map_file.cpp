@@ -6,6 +6,7 @@
 #include "neepp/io/atomic_file.h"
 #include "neepp/io/binary_io.h"
 #include "neepp/scene/scene.h"
+#include "neepp/scene/sdf_grid.h"
 
 namespace neepp {
 
@@ -31,6 +32,12 @@ uint64_t scene_fingerprint(const Scene &scene) {
         if (ni) mix(s->indices.data(), ni * sizeof(uint32_t));
         mix(&s->center, sizeof(Vec3));
         mix(&s->radius, sizeof(float));
+        if (s->sdf_grid) {
+            const uint32_t dims[3] = {s->sdf_grid->size(0), s->sdf_grid->size(1), s->sdf_grid->size(2)};
+            mix(dims, sizeof dims);
+            mix(s->sdf_grid->values().data(), s->sdf_grid->values().size() * sizeof(float));
+            mix(&s->sdf_to_world.matrix, sizeof(Matrix4));
+        }
     }
     mix(&lights, sizeof lights);
     for (const auto &l : scene.lights()) {
