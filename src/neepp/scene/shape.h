@@ -1,5 +1,5 @@
-// A shape of the scene: a triangle mesh in world space (or an analytic sphere), its material, and the
-// area light it carries if it emits.
+// A shape of the scene: a triangle mesh in world space (or an analytic sphere, or curves), its material,
+// and the area light it carries if it emits.
 #pragma once
 #include <memory>
 #include <optional>
@@ -9,6 +9,7 @@
 #include "neepp/materials/bsdf.h"
 #include "neepp/math/bbox.h"
 #include "neepp/math/distribution.h"
+#include "neepp/scene/curve.h"
 #include "neepp/scene/interaction.h"
 
 namespace neepp {
@@ -23,7 +24,7 @@ struct PositionSample {
 };
 
 struct Shape {
-    enum class Kind { Mesh, Sphere };
+    enum class Kind { Mesh, Sphere, Curve };
     Kind kind = Kind::Mesh;
     std::string id;
 
@@ -41,6 +42,13 @@ struct Shape {
     Vec3 center;
     float radius = 0;
     Vec3 sphere_axes[3] = {{1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
+
+    // Curve data (Mitsuba's linearcurve and bsplinecurve), world space: the control points with their
+    // radii, and the first control point of each segment (CurveData::segments). Curves have no area and
+    // cannot emit, as in Mitsuba, which cannot sample a point on them.
+    CurveBasis curve_basis = CurveBasis::Linear;
+    std::vector<CurvePoint> curve_points;
+    std::vector<uint32_t> curve_segments;
 
     BSDFPtr bsdf;
     const Light *area_light = nullptr;  // set when the scene creates an area light for this shape
@@ -72,7 +80,8 @@ struct Shape {
     PositionSample sample_position(Vec2 u, bool with_uv = true) const;
     float pdf_position() const { return area_ > 0 ? 1.f / area_ : 0.f; }
 
-    // Completes a hit record from Embree's primitive index and barycentrics (or sphere hit).
+    // Completes a hit record from Embree's primitive index and barycentrics (a sphere's: unused; a curve's:
+    // b1 is the parameter along segment prim).
     void fill_interaction(uint32_t prim, float b1, float b2, const Ray &ray, float t,
                           SurfaceInteraction &si) const;
     // Triangle hits waiting to be filled eight at a time (hit_lanes.cpp), as fill_interaction and then
@@ -124,7 +133,7 @@ struct Shape {
     // Cache prefetch of what fill_interaction(prim) reads: its triangle's record, two cache lines.
     // Inline: it runs once per ray, from the integrator's batch loop.
     void prefetch(uint32_t prim) const {
-        if (kind == Kind::Sphere) return;
+        if (kind != Kind::Mesh) return;
         const char *record = reinterpret_cast<const char *>(&hit_triangles_[prim]);
         __builtin_prefetch(record);
         __builtin_prefetch(record + sizeof(HitTriangle) - 1);

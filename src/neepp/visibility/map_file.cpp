@@ -31,6 +31,10 @@ uint64_t scene_fingerprint(const Scene &scene) {
         if (ni) mix(s->indices.data(), ni * sizeof(uint32_t));
         mix(&s->center, sizeof(Vec3));
         mix(&s->radius, sizeof(float));
+        if (!s->curve_points.empty()) {  // only for curves: meshes and spheres keep their fingerprints
+            mix(s->curve_points.data(), s->curve_points.size() * sizeof(CurvePoint));
+            mix(s->curve_segments.data(), s->curve_segments.size() * sizeof(uint32_t));
+        }
     }
     mix(&lights, sizeof lights);
     for (const auto &l : scene.lights()) {
