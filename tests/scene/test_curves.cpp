@@ -93,6 +93,24 @@ TEST(Curves, NoHitFromInsideATube) {
     SurfaceInteraction si;
     EXPECT_FALSE(scene->intersect(Ray{Vec3(0, 0, 0), Vec3(0, 0, 1)}, si));
     EXPECT_FALSE(scene->occluded(Ray{Vec3(0.5f, 0, 0), normalize(Vec3(0.3f, 0.2f, 1))}));
+    // The same in packets (Embree calls the culling filter with several rays at once), at every width.
+    std::vector<Ray> rays;
+    for (int i = 0; i < 16; ++i) rays.push_back(Ray{Vec3(-0.9f + 0.1f * i, 0, 0), normalize(Vec3(0.1f, 0.2f, i % 2 ? 1.f : -1.f))});
+    std::vector<const Ray *> rp;
+    for (const Ray &r : rays) rp.push_back(&r);
+    for (int width : {4, 8, 16}) {
+        scene->set_packet_width(width);
+        RayHit hits[16];
+        RayHit *hp[16];
+        for (int i = 0; i < 16; ++i) hp[i] = &hits[i];
+        scene->trace16(rp.data(), hp, 16);
+        bool occluded[16];
+        scene->occluded16(rp.data(), 16, occluded);
+        for (int i = 0; i < 16; ++i) {
+            EXPECT_FALSE(hits[i].valid()) << "ray " << i << ", width " << width;
+            EXPECT_FALSE(occluded[i]) << "ray " << i << ", width " << width;
+        }
+    }
     // From outside, the near side only: the ray leaving it again passes out unhit.
     si = hit_down(*scene, Vec3(0, 0, 5));
     EXPECT_NEAR(si.t, 4.75f, 2e-5f);
