@@ -1,7 +1,7 @@
 // The scene loader on arbitrary XML: parsing (pugixml, then Mitsuba's elements: defaults, -D
 // substitution, includes, refs, transforms), every plugin's parameters, and building the scene (meshes,
-// textures, lights, the BVH). The input is written beside a small OBJ, PLY, .serialized, .vol and PNG, so that
-// files it names can be found. The first line, when it starts with "-D ", holds name=value parameter overrides
+// textures, lights, the BVH). The input is written beside a small OBJ, PLY, .serialized, .vol, curve file and
+// PNG, so that files it names can be found. The first line, when it starts with "-D ", holds name=value parameter overrides
 // (as the CLI's -D), to fuzz their substitution too.
 #include <exception>
 #include <map>
@@ -21,6 +21,9 @@ void write_companions() {
         "element face 1\nproperty list uchar int vertex_indices\nend_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n";
     neepp::fuzz::write_input(reinterpret_cast<const uint8_t *>(kObj), sizeof(kObj) - 1, "mesh.obj");
     neepp::fuzz::write_input(reinterpret_cast<const uint8_t *>(kPly), sizeof(kPly) - 1, "mesh.ply");
+    // Two curves, long enough for either basis.
+    static const char kCurves[] = "0 0 0 0.1\n0.3 0.5 0 0.1\n0.6 0 0 0.1\n1 0.5 0 0\n\n0 1 0 0.2\n1 1 0 0.2\n2 1 1 0.2\n3 1 0 0.2\n";
+    neepp::fuzz::write_input(reinterpret_cast<const uint8_t *>(kCurves), sizeof(kCurves) - 1, "curves.txt");
     neepp::testing::SerializedTestMesh tri;
     tri.positions = {0, 0, 0, 1, 0, 0, 0, 1, 0};
     tri.indices = {0, 1, 2};
@@ -60,6 +63,15 @@ extern "C" int LLVMFuzzerInitialize(int *, char ***) {
             "<shape type='instance'><ref id='group'/></shape>"
             "<shape type='instance'><ref id='group'/><transform name='to_world'><translate x='2'/></transform></shape>"
             "<emitter type='constant'/></scene>\n");
+        neepp::fuzz::write_seed(
+            dir, "curves.xml",
+            "<scene version='3.0.0'><sensor type='perspective'><film type='hdrfilm'><integer name='width' value='8'/>"
+            "<integer name='height' value='8'/></film></sensor>"
+            "<shape type='linearcurve'><string name='filename' value='curves.txt'/><transform name='to_world'>"
+            "<scale x='2'/></transform><bsdf type='diffuse'/></shape>"
+            "<shape type='shapegroup' id='hair'><shape type='bsplinecurve'><string name='filename' value='curves.txt'/>"
+            "</shape></shape><shape type='instance'><ref id='hair'/><transform name='to_world'><scale value='0.5'/>"
+            "</transform></shape><emitter type='constant'/></scene>\n");
     });
     write_companions();
     return 0;

@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Runs the libFuzzer targets of fuzz/ (see fuzz/README.md), as many at a time as there are cores
 # (NEEPP_FUZZ_JOBS to choose), each for SECONDS (default 30):
-# the scene loader, the OBJ, PLY, .serialized and .vol readers, image reading, visibility-map files and
+# the scene loader, the OBJ, PLY, .serialized, .vol and curve readers, image reading, visibility-map files and
 # integrator options.
 # Each target starts from its built-in seeds plus the project's and the shared scenes' files, keeps the
 # corpus it grows in build-sanitize/fuzz/corpus/, and writes any crashing, hanging or leaking input to
@@ -12,7 +12,7 @@ ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 SECONDS_EACH="${1:-30}"
 shift || true
 TARGETS=("$@")
-[ ${#TARGETS[@]} -eq 0 ] && TARGETS=(scene obj ply serialized volume_grid image map_file integrator_options)
+[ ${#TARGETS[@]} -eq 0 ] && TARGETS=(scene obj ply serialized volume_grid curves image map_file integrator_options)
 SHARED="$ROOT/../shared/scenes"
 B="$ROOT/build-sanitize"
 W="$B/fuzz"

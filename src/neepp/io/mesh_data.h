@@ -1,5 +1,5 @@
 // Triangle mesh data as read from a file, before any to_world transform is applied, plus the few
-// helpers the OBJ and PLY readers share.
+// helpers the OBJ, PLY, .serialized and curve readers share.
 #pragma once
 #include <charconv>
 #include <cmath>
@@ -36,9 +36,10 @@ struct MeshData {
 
 namespace mesh_detail {
 
-inline std::string read_file(const std::string &path) {
+// The whole file; what names it in the error when it cannot be opened ("mesh file", "curve file").
+inline std::string read_file(const std::string &path, const char *what = "mesh file") {
     std::ifstream in(path, std::ios::binary);
-    if (!in) throw SceneError(path, "cannot open mesh file");
+    if (!in) throw SceneError(path, std::string("cannot open ") + what);
     std::ostringstream ss;
     ss << in.rdbuf();
     return std::move(ss).str();

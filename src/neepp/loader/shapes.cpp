@@ -1,6 +1,7 @@
 #include <cmath>
 #include <fmt/core.h>
 #include "neepp/loader/supported_plugins.h"
+#include "neepp/io/curve_reader.h"
 #include "neepp/io/obj_reader.h"
 #include "neepp/io/ply_reader.h"
 #include "neepp/io/serialized_reader.h"
@@ -166,12 +167,42 @@ void compute_vertex_normals(Shape &s) {
     }
 }
 
+// The scale of a to_world that scales all directions alike (it may also translate, rotate and mirror);
+// throws, naming it (what), for one that shears or scales some directions more than others.
+float uniform_scale(const Transform &to_world, const std::string &what) {
+    Vec3 axes[3];
+    float scale[3];
+    for (int i = 0; i < 3; ++i) {
+        axes[i] = to_world.vector(Vec3(i == 0, i == 1, i == 2));
+        scale[i] = norm(axes[i]);
+    }
+    const float tol = 1e-4f * scale[0] * scale[0];
+    if (std::abs(scale[1] - scale[0]) > 1e-4f * scale[0] || std::abs(scale[2] - scale[0]) > 1e-4f * scale[0] ||
+        std::abs(dot(axes[0], axes[1])) > tol || std::abs(dot(axes[0], axes[2])) > tol || std::abs(dot(axes[1], axes[2])) > tol)
+        throw std::runtime_error(what + " must scale uniformly (and not shear)");
+    return scale[0];
+}
+
+// Mitsuba's `linearcurve` and `bsplinecurve`: the file's control points moved by to_world, their radii
+// as written (Mitsuba's to_world does not scale them).
+void set_curves(Shape &s, CurveBasis basis, CurveData curves, const Transform &to_world) {
+    s.kind = Shape::Kind::Curve;
+    s.curve_basis = basis;
+    s.curve_points.resize(curves.points.size());
+    for (size_t i = 0; i < curves.points.size(); ++i) {
+        s.curve_points[i] = {to_world.point(curves.points[i]), curves.radii[i]};
+        if (!is_finite(s.curve_points[i].p)) throw std::runtime_error("the transformed curve has non-finite control points");
+    }
+    s.curve_segments = std::move(curves.segments);
+}
+
 }  // namespace
 
-// Moves the shape's mesh or sphere by `to_world`: a mesh's vertex normals keep their direction
-// relative to the surface (the inverse transpose, renormalized). A to_world on a sphere may translate,
-// rotate, mirror and scale uniformly, its axes turning with it (Mitsuba allows more; neepp refuses). An
-// SDF grid takes any affine to_world: rays go to its space.
+// Moves the shape by `to_world`: a mesh's vertex normals keep their direction relative to the surface
+// (the inverse transpose, renormalized). A to_world on a sphere or on curves (an instance's: this is not
+// where a curve shape's own to_world is applied, which leaves radii alone) may translate, rotate, mirror
+// and scale uniformly, a sphere's axes turning with it and radii scaling with it (Mitsuba allows more;
+// neepp refuses). An SDF grid takes any affine to_world: rays go to its space.
 void transform_shape(Shape &s, const Transform &to_world) {
     if (s.kind == Shape::Kind::SdfGrid) {
         s.sdf_to_world = to_world * s.sdf_to_world;
@@ -181,21 +212,22 @@ void transform_shape(Shape &s, const Transform &to_world) {
         return;
     }
     if (s.kind == Shape::Kind::Sphere) {
-        Vec3 axes[3];
-        float scale[3];
-        for (int i = 0; i < 3; ++i) {
-            axes[i] = to_world.vector(s.sphere_axes[i]);
-            scale[i] = norm(axes[i]);
-        }
-        const float tol = 1e-4f * scale[0] * scale[0];
-        if (std::abs(scale[1] - scale[0]) > 1e-4f * scale[0] || std::abs(scale[2] - scale[0]) > 1e-4f * scale[0] ||
-            std::abs(dot(axes[0], axes[1])) > tol || std::abs(dot(axes[0], axes[2])) > tol || std::abs(dot(axes[1], axes[2])) > tol)
-            throw std::runtime_error("sphere to_world must scale uniformly (and not shear)");
+        const float scale = uniform_scale(to_world, "sphere to_world");
         s.center = to_world.point(s.center);
-        s.radius *= scale[0];
+        s.radius *= scale;
         if (!(s.radius > 0) || !std::isfinite(s.radius) || !is_finite(s.center))
             throw std::runtime_error("sphere needs a positive radius and a finite center");
-        for (int i = 0; i < 3; ++i) s.sphere_axes[i] = axes[i] / scale[i];
+        for (Vec3 &axis : s.sphere_axes) axis = normalize(to_world.vector(axis));
+        return;
+    }
+    if (s.kind == Shape::Kind::Curve) {
+        const float scale = uniform_scale(to_world, "the to_world of an instance of curves");
+        for (CurvePoint &cp : s.curve_points) {
+            cp.p = to_world.point(cp.p);
+            cp.radius *= scale;
+            if (!is_finite(cp.p) || !std::isfinite(cp.radius))
+                throw std::runtime_error("the transformed curve has non-finite control points");
+        }
         return;
     }
     for (Vec3 &p : s.positions) {
@@ -249,6 +281,9 @@ void Factories::shape(const XmlNode &node, Scene &scene) {
     Shape *shape = s.get();
     scene.add_shape(std::move(s));
     if (emitter_node) attempt([&] {
+        if (shape->kind == Shape::Kind::Curve)  // Mitsuba loads it, then fails at the first render
+            throw emitter_node->error("a " + node.type + " cannot carry an emitter (curves have no surface area "
+                                      "to sample a point of; Mitsuba 3 cannot render one either)");
         if (emitter_node->type != "area") throw emitter_node->error("a shape can only carry an 'area' emitter");
         if (shape->kind == Shape::Kind::SdfGrid)
             throw emitter_node->error("an sdfgrid cannot carry an area emitter (Mitsuba 3's sdfgrid cannot be an emitter)");
@@ -267,8 +302,8 @@ std::unique_ptr<Shape> Factories::build_shape(const XmlNode &node, const XmlNode
     auto s = std::make_unique<Shape>();
     s->id = node.id;
     const std::string &t = node.type;
-    // Mitsuba's sdfgrid has neither option: left unread, either is reported as unused.
-    if (t != "sdfgrid") {
+    // Mitsuba's sdfgrid and curves have neither option: left unread, either is reported as unused.
+    if (t != "sdfgrid" && t != "linearcurve" && t != "bsplinecurve") {
         s->face_normals = node.get_bool("face_normals", false);
         s->flip_normals = node.get_bool("flip_normals", false);
     }
@@ -284,6 +319,16 @@ std::unique_ptr<Shape> Factories::build_shape(const XmlNode &node, const XmlNode
                 throw node.error(e.what());
             }
             set_mesh(*s, std::move(mesh), to_world);
+        } else if (t == "linearcurve" || t == "bsplinecurve") {
+            const CurveBasis basis = t == "linearcurve" ? CurveBasis::Linear : CurveBasis::BSpline;
+            const std::string path = node.resolve_path(node.get_string("filename"));
+            CurveData curves;
+            try {
+                curves = read_curves(path, basis);
+            } catch (const std::exception &e) {  // the file's own error, located at the shape using it
+                throw node.error(e.what());
+            }
+            set_curves(*s, basis, std::move(curves), to_world);
         } else if (t == "rectangle") {
             set_mesh(*s, rectangle_mesh(), to_world);
         } else if (t == "cube") {

@@ -7,7 +7,7 @@ namespace neepp {
 const std::vector<std::pair<std::string, std::vector<std::string>>> &supported_plugins() {
     static const std::vector<std::pair<std::string, std::vector<std::string>>> plugins = {
         {"shape", {"obj", "ply", "rectangle", "cube", "sphere", "disk", "cylinder", "serialized", "sdfgrid",
-                   "shapegroup", "instance"}},
+                   "linearcurve", "bsplinecurve", "shapegroup", "instance"}},
         {"bsdf", {"diffuse", "twosided", "mask", "bumpmap", "conductor", "roughconductor", "plastic", "roughplastic",
                   "dielectric", "roughdielectric", "thindielectric", "principled", "principledthin", "null", "normalmap",
                   "blendbsdf"}},

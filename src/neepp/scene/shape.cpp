@@ -25,6 +25,7 @@ void Shape::finalize() {
         sdf_to_object_ = sdf_to_world.inverse();
         return;
     }
+    if (kind == Kind::Curve) return;  // no area: curves cannot emit
     std::vector<float> areas(triangle_count());
     double total = 0;
     for (size_t i = 0; i < areas.size(); ++i) {
@@ -102,6 +103,12 @@ BBox Shape::bounds() const {
         b.expand(center + Vec3(radius));
     } else if (kind == Kind::SdfGrid) {
         for (int k = 0; k < 8; ++k) b.expand(sdf_to_world.point(Vec3(float(k & 1), float(k >> 1 & 1), float(k >> 2 & 1))));
+    } else if (kind == Kind::Curve) {
+        // A segment's every point is a convex combination of its control points, each moved by its own radius.
+        for (const CurvePoint &cp : curve_points) {
+            b.expand(cp.p - Vec3(cp.radius));
+            b.expand(cp.p + Vec3(cp.radius));
+        }
     } else {
         for (const Vec3 &p : positions) b.expand(p);
     }
@@ -143,6 +150,21 @@ PositionSample Shape::sample_position(Vec2 u, bool with_uv) const {
     return ps;
 }
 
+namespace {
+
+// The shading frame around n with s along dp/du made perpendicular to n (Gram-Schmidt), as Mitsuba aligns
+// it, so anisotropic and bump-mapped materials have a consistent tangent; around n alone where dp/du has
+// no part across n.
+[[gnu::always_inline]] inline Frame frame_along(const Vec3 &n, const Vec3 &dpdu) {
+    Vec3 s = dpdu - n * dot(n, dpdu);
+    const float s2 = squared_norm(s);
+    if (!(s2 > 1e-20f && std::isfinite(s2))) return Frame(n);
+    s = s / std::sqrt(s2);
+    return Frame(s, cross(n, s), n);
+}
+
+}  // namespace
+
 // Always inlined into fill_interaction (both of its paths; GCC otherwise keeps it out of line, and the
 // call is costly on a path this hot). Inlined, its arithmetic may fuse differently with the caller's
 // (FMA), which moves a few paths onto other random decisions: the same image statistically, not to the bit.
@@ -183,6 +205,22 @@ void Shape::fill_interaction(uint32_t prim, float b1, float b2, const Ray &ray, 
         return;
     }
     if (kind == Kind::SdfGrid) return fill_sdf_interaction(ray, t, si);
+    if (kind == Kind::Curve) {
+        si.p = ray.at(t);
+        const CurveHit h = curve_hit(curve_basis, &curve_points[curve_segments[prim]], prim,
+                                     uint32_t(curve_segments.size()), b1, si.p);
+        si.n = h.n;
+        si.uv = h.uv;
+        // Mitsuba's curves shade with the geometric normal, the frame's s around the tube.
+        if (tangents) {
+            si.dpdu = h.dpdu, si.dpdv = h.dpdv;
+            si.sh_frame = frame_along(h.n, h.dpdu);
+        } else {
+            si.dpdu = si.dpdv = Vec3(0.f);
+            si.sh_frame = Frame(h.n);
+        }
+        return;
+    }
     const HitTriangle &tri = hit_triangles_[prim];
     const Vec3 &p0 = tri.p[0], &p1 = tri.p[1], &p2 = tri.p[2];
     float b0 = 1.f - b1 - b2;
@@ -216,17 +254,7 @@ void Shape::fill_interaction(uint32_t prim, float b1, float b2, const Ray &ray, 
         si.dpdu = e1; si.dpdv = e2;
     }
 
-    const Vec3 ns = shading_normal(tri, b0, b1, b2, ng);
-    // Shading frame aligned with dp/du (Gram-Schmidt), as Mitsuba does, so anisotropic and bump-mapped
-    // materials have a consistent tangent.
-    Vec3 s = si.dpdu - ns * dot(ns, si.dpdu);
-    float s2 = squared_norm(s);
-    if (s2 > 1e-20f && std::isfinite(s2)) {
-        s = s / std::sqrt(s2);
-        si.sh_frame = Frame(s, cross(ns, s), ns);
-    } else {
-        si.sh_frame = Frame(ns);
-    }
+    si.sh_frame = frame_along(shading_normal(tri, b0, b1, b2, ng), si.dpdu);
 }
 
 // As Mitsuba's sdfgrid: the point on the ray; the geometric normal the gradient of the hit voxel's

@@ -1,5 +1,5 @@
-// A shape of the scene: a triangle mesh in world space (or an analytic sphere, or an SDF grid), its
-// material, and the area light it carries if it emits.
+// A shape of the scene: a triangle mesh in world space (or an analytic sphere, an SDF grid, or curves),
+// its material, and the area light it carries if it emits.
 #pragma once
 #include <memory>
 #include <optional>
@@ -10,6 +10,7 @@
 #include "neepp/math/bbox.h"
 #include "neepp/math/distribution.h"
 #include "neepp/math/transform.h"
+#include "neepp/scene/curve.h"
 #include "neepp/scene/interaction.h"
 
 namespace neepp {
@@ -25,7 +26,7 @@ struct PositionSample {
 };
 
 struct Shape {
-    enum class Kind { Mesh, Sphere, SdfGrid };
+    enum class Kind { Mesh, Sphere, SdfGrid, Curve };
     Kind kind = Kind::Mesh;
     std::string id;
 
@@ -51,6 +52,12 @@ struct Shape {
     Transform sdf_to_world;
     // sdf_to_world's inverse, which every ray against the grid goes through; set by finalize().
     const Transform &sdf_to_object() const { return sdf_to_object_; }
+    // Curve data (Mitsuba's linearcurve and bsplinecurve), world space: the control points with their
+    // radii, and the first control point of each segment (CurveData::segments). Curves have no area and
+    // cannot emit, as in Mitsuba, which cannot sample a point on them.
+    CurveBasis curve_basis = CurveBasis::Linear;
+    std::vector<CurvePoint> curve_points;
+    std::vector<uint32_t> curve_segments;
 
     BSDFPtr bsdf;
     const Light *area_light = nullptr;  // set when the scene creates an area light for this shape
@@ -82,7 +89,8 @@ struct Shape {
     PositionSample sample_position(Vec2 u, bool with_uv = true) const;
     float pdf_position() const { return area_ > 0 ? 1.f / area_ : 0.f; }
 
-    // Completes a hit record from Embree's primitive index and barycentrics (or sphere hit).
+    // Completes a hit record from Embree's primitive index and barycentrics (a sphere's: unused; a curve's:
+    // b1 is the parameter along segment prim).
     void fill_interaction(uint32_t prim, float b1, float b2, const Ray &ray, float t,
                           SurfaceInteraction &si) const;
     // Triangle hits waiting to be filled eight at a time (hit_lanes.cpp), as fill_interaction and then

@@ -38,6 +38,10 @@ uint64_t scene_fingerprint(const Scene &scene) {
             mix(s->sdf_grid->values().data(), s->sdf_grid->values().size() * sizeof(float));
             mix(&s->sdf_to_world.matrix, sizeof(Matrix4));
         }
+        if (!s->curve_points.empty()) {  // only for curves: meshes and spheres keep their fingerprints
+            mix(s->curve_points.data(), s->curve_points.size() * sizeof(CurvePoint));
+            mix(s->curve_segments.data(), s->curve_segments.size() * sizeof(uint32_t));
+        }
     }
     mix(&lights, sizeof lights);
     for (const auto &l : scene.lights()) {

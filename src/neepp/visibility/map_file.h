@@ -18,7 +18,7 @@ namespace neepp {
 
 class Scene;
 
-// A hash of what visibility depends on: every shape's geometry (positions, indices, spheres), the
+// A hash of what visibility depends on: every shape's geometry (positions, indices, spheres, curves), the
 // lights' kinds and the scene bounds. Materials, textures and the camera do not change visibility, so a
 // map stays valid when they change.
 uint64_t scene_fingerprint(const Scene &scene);
