@@ -164,12 +164,13 @@ TEST(Hair, SampleWeightIsEvalOverPdfInBothModes) {
 
 // Without absorption every walk leaves the fibre: from any direction, grazing along the fibre and from
 // behind included, eval integrates to 1 over the sphere (each lobe is normalized and the attenuations
-// sum to 1), however narrow the lobes. Every sample then weighs exactly 1.
+// sum to 1), however narrow the lobes. Every sample then weighs exactly 1. (Mitsuba's, with its
+// approximate Bessel function, reflects 0.9956 at beta 0.5 and normal incidence.)
 TEST(Hair, WhiteFurnaceIsOne) {
     SurfaceInteraction si;
     PCG32 rng(2, 9);
     double worst = 0;
-    for (float beta : {0.1f, 0.3f, 0.7f, 1.f}) {
+    for (float beta : {0.1f, 0.3f, 0.5f, 1.f}) {
         HairParams p;
         p.sigma_a = constant_texture(0.f);
         p.longitudinal_roughness = beta, p.azimuthal_roughness = std::min(1.f, beta + 0.1f);
