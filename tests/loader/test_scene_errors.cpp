@@ -3,6 +3,7 @@
 #include <fstream>
 #include "neepp/io/scene_error.h"
 #include "neepp/materials/blendbsdf.h"
+#include "neepp/materials/hair.h"
 #include "neepp/materials/normalmap.h"
 #include "neepp/materials/principled.h"
 #include "neepp/materials/principledthin.h"
@@ -140,6 +141,61 @@ TEST(SceneLoader, PrincipledThinLoadsWithItsLobes) {
     EXPECT_FALSE(sheet->flags() & BSDFDiffuseTransmission);
     EXPECT_TRUE(sheet->needs_tangents());
     load_error(scene_with(std::string(kLight) + R"(<shape type="sphere"><bsdf type="principledthin"><float name="diffuse_reflectance_sampling_rate" value="0"/></bsdf></shape>)"));
+}
+
+// hair: Mitsuba's parameters (pigments by default, or sigma_a times scale; amber in air) reach the BSDF,
+// which then evaluates as one built from the same values.
+TEST(SceneLoader, HairLoadsMitsubasParameters) {
+    auto load_bsdf = [](const std::string &params) {
+        std::string path = write_temp_scene(scene_with(std::string(kLight) + "<shape type=\"cylinder\"><bsdf type=\"hair\">" +
+                                                       params + "</bsdf></shape>"));
+        return load_scene(path)->shapes().at(0)->bsdf;
+    };
+    auto expect_same = [](const BSDFPtr &loaded, HairParams p) {
+        ASSERT_TRUE(std::dynamic_pointer_cast<const HairBSDF>(loaded));
+        EXPECT_TRUE(loaded->needs_tangents());
+        const HairBSDF built(p);
+        SurfaceInteraction si;
+        const BSDFContext ctx;
+        for (const Vec3 &wi : {normalize(Vec3(0.3f, 0.4f, 0.8f)), normalize(Vec3(-0.5f, -0.2f, 0.3f))})
+            for (const Vec3 &wo : {normalize(Vec3(-0.3f, -0.4f, 0.8f)), normalize(Vec3(0.2f, 0.1f, -0.9f))}) {
+                const Color a = loaded->eval(ctx, si, wi, wo), b = built.eval(ctx, si, wi, wo);
+                for (int c = 0; c < 3; ++c) EXPECT_FLOAT_EQ(a[c], b[c]);
+                EXPECT_FLOAT_EQ(loaded->pdf(ctx, si, wi, wo), built.pdf(ctx, si, wi, wo));
+            }
+    };
+    HairParams defaults;
+    defaults.sigma_a = constant_texture(hair_pigment_absorption(1.3f, 0.2f));
+    expect_same(load_bsdf(""), defaults);
+    HairParams pigments = defaults;
+    pigments.sigma_a = constant_texture(hair_pigment_absorption(0.01f, 1.6f));
+    pigments.longitudinal_roughness = 0.2f, pigments.azimuthal_roughness = 0.6f, pigments.scale_tilt_deg = -3.f;
+    pigments.eta = 1.333f / 1.000277f;  // water
+    // A scale beside pigments is read, as Mitsuba reads it, and scales nothing.
+    expect_same(load_bsdf(R"(<float name="eumelanin" value="0.01"/><float name="pheomelanin" value="1.6"/>
+        <float name="longitudinal_roughness" value="0.2"/><float name="azimuthal_roughness" value="0.6"/>
+        <float name="scale_tilt" value="-3"/><string name="int_ior" value="water"/><float name="scale" value="9"/>)"), pigments);
+    HairParams absorption = defaults;
+    absorption.sigma_a = constant_texture(Color(0.2f, 0.25f, 0.7f));
+    absorption.sigma_a_scale = 200.f;
+    absorption.eta = 1.6f / 1.2f;
+    expect_same(load_bsdf(R"(<rgb name="sigma_a" value="0.2, 0.25, 0.7"/><float name="scale" value="200"/>
+        <float name="int_ior" value="1.6"/><float name="ext_ior" value="1.2"/>)"), absorption);
+}
+
+TEST(SceneErrors, HairSaysWhatIsWrong) {
+    auto hair_error = [](const std::string &params) {
+        return load_error(scene_with(std::string(kLight) + "\n<shape type=\"cylinder\"><bsdf type=\"hair\">" + params +
+                                     "</bsdf></shape>"));
+    };
+    std::string msg = hair_error(R"(<rgb name="sigma_a" value="0.2"/><float name="eumelanin" value="0.3"/>)");
+    EXPECT_NE(msg.find(":4:"), std::string::npos) << msg;
+    EXPECT_NE(msg.find("either 'sigma_a' or the pigments"), std::string::npos) << msg;
+    EXPECT_NE(hair_error(R"(<float name="longitudinal_roughness" value="0"/>)").find("(0, 1]"), std::string::npos);
+    EXPECT_NE(hair_error(R"(<float name="azimuthal_roughness" value="2"/>)").find("azimuthal_roughness"), std::string::npos);
+    EXPECT_NE(hair_error(R"(<float name="int_ior" value="1.2"/><float name="ext_ior" value="1.2"/>)").find("must differ"),
+              std::string::npos);
+    EXPECT_NE(hair_error(R"(<float name="pheomelanin" value="-1"/>)").find("non-negative"), std::string::npos);
 }
 
 // normalmap and blendbsdf: a missing normal map names its path, and each wrapper says what it lacks.

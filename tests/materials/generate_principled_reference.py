@@ -64,24 +64,25 @@ def vec(v):
     return "{" + ", ".join(f(x) for x in v) + "}"
 
 
-def print_references(script, bsdfs):
-    """Prints the .inc lines for (name, plugin, parameters) triples: eval, pdf and sample at every query."""
+def print_references(script, bsdfs, modes=("Radiance", "Importance"), wis=WIS, wos=WOS, samples=SAMPLES):
+    """Prints the .inc lines for (name, plugin, parameters) triples: eval, pdf and sample at every query
+    (each incident direction with each outgoing one and each pair of random numbers), in the given modes."""
     print("// Reference values generated with Mitsuba %s (pip package, scalar_rgb variant) by"
           % mi.__version__)
     print(f"// tests/materials/{script}; one line per query.")
     for name, plugin, params in bsdfs:
         bsdf = mi.load_dict({"type": plugin, **params})
-        for mode_name, mode in (("Radiance", mi.TransportMode.Radiance), ("Importance", mi.TransportMode.Importance)):
-            ctx = mi.BSDFContext(mode)
-            for wi in WIS:
+        for mode_name in modes:
+            ctx = mi.BSDFContext(getattr(mi.TransportMode, mode_name))
+            for wi in wis:
                 si = mi.SurfaceInteraction3f()
                 si.wi = wi
                 head = f'    {{"{name}", TransportMode::{mode_name}, {vec(wi)}, '
-                for wo in WOS:
+                for wo in wos:
                     value = bsdf.eval(ctx, si, wo)
                     pdf = bsdf.pdf(ctx, si, wo)
                     print(head + f"{vec(wo)}, Eval{{{vec(value)}, {f(pdf)}}}}},")
-                for u1, u2 in SAMPLES:
+                for u1, u2 in samples:
                     bs, weight = bsdf.sample(ctx, si, u1, mi.ScalarPoint2f(*u2))
                     print(head + f"Sample{{{f(u1)}, {vec(u2)}, {vec(bs.wo)}, {f(bs.pdf)}, {f(bs.eta)}, "
                           f"{vec(weight)}}}}},")

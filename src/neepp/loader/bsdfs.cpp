@@ -7,6 +7,7 @@
 #include "neepp/materials/conductor.h"
 #include "neepp/materials/dielectric.h"
 #include "neepp/materials/diffuse.h"
+#include "neepp/materials/hair.h"
 #include "neepp/materials/ior.h"
 #include "neepp/materials/normalmap.h"
 #include "neepp/materials/plastic.h"
@@ -107,6 +108,31 @@ PrincipledThinParams Factories::principled_thin_params(const XmlNode &node) {
         if (!(rate >= 0.f)) throw node.error("sampling rates must be non-negative");
     if (!(p.diffuse_reflectance_sampling_rate > 0.f))
         throw node.error("'diffuse_reflectance_sampling_rate' must be positive (the diffuse lobe would never be sampled)");
+    return p;
+}
+
+// Mitsuba's hair: pigment concentrations or an absorption texture (scaled by `scale`), not both.
+HairParams Factories::hair_params(const XmlNode &node) {
+    HairParams p;
+    p.longitudinal_roughness = node.get_float("longitudinal_roughness", p.longitudinal_roughness);
+    p.azimuthal_roughness = node.get_float("azimuthal_roughness", p.azimuthal_roughness);
+    p.scale_tilt_deg = node.get_float("scale_tilt", p.scale_tilt_deg);
+    const float int_ior = ior_param(node, "int_ior", 1.55f), ext_ior = ior_param(node, "ext_ior", 1.000277f);
+    if (int_ior == ext_ior) throw node.error("'int_ior' and 'ext_ior' must differ");
+    p.eta = int_ior / ext_ior;
+    // Read whichever absorption is used, as Mitsuba does (a scale beside pigments is then merely unused).
+    p.sigma_a_scale = node.get_float("scale", 1.f);
+    const bool pigments = node.has("eumelanin") || node.has("pheomelanin");
+    if (node.has("sigma_a") || node.child("sigma_a")) {
+        if (pigments) throw node.error("give either 'sigma_a' or the pigments 'eumelanin'/'pheomelanin', not both");
+        p.sigma_a = texture_param(node, "sigma_a", Color(0.f), true);
+    } else {
+        const float eumelanin = node.get_float("eumelanin", 1.3f), pheomelanin = node.get_float("pheomelanin", 0.2f);
+        if (!(eumelanin >= 0.f && pheomelanin >= 0.f) || !std::isfinite(eumelanin + pheomelanin))
+            throw node.error("pigment concentrations must be non-negative and finite");
+        p.sigma_a = constant_texture(hair_pigment_absorption(eumelanin, pheomelanin));
+        p.sigma_a_scale = 1.f;
+    }
     return p;
 }
 
@@ -238,6 +264,8 @@ BSDFPtr Factories::create_bsdf(const XmlNode &node) {
                                                   texture_param_or_null(node, "specular_reflectance"),
                                                   texture_param_or_null(node, "specular_transmittance"),
                                                   node.get_bool("sample_visible", true));
+    } else if (t == "hair") {
+        b = std::make_shared<HairBSDF>(hair_params(node));
     } else if (t == "principled") {
         b = std::make_shared<PrincipledBSDF>(principled_params(node));
     } else if (t == "principledthin") {

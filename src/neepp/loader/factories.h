@@ -5,6 +5,7 @@
 #include <memory>
 #include "neepp/io/xml_tree.h"
 #include "neepp/materials/bsdf.h"
+#include "neepp/materials/hair.h"
 #include "neepp/materials/principled.h"
 #include "neepp/materials/principledthin.h"
 #include "neepp/scene/scene.h"
@@ -37,6 +38,7 @@ private:
     TexturePtr principled_lobe_param(const XmlNode &node, const std::string &name);
     PrincipledParams principled_params(const XmlNode &node);
     PrincipledThinParams principled_thin_params(const XmlNode &node);
+    HairParams hair_params(const XmlNode &node);
     std::map<const XmlNode *, TexturePtr> textures_;
     std::map<const XmlNode *, BSDFPtr> bsdfs_;
     std::map<const XmlNode *, std::vector<Shape>> shape_groups_;
