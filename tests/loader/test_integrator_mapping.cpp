@@ -32,6 +32,10 @@ TEST(IntegratorMapping, MitsubasIntegratorsRenderAsTheirEquivalent) {
         {R"(<integrator type="prb_basic"/>)", "path", {}},
         {R"(<integrator type="volpath"><integer name="rr_depth" value="3"/></integrator>)", "path", {{"rr_depth", "3"}}},
         {R"(<integrator type="volpathmis"/>)", "path", {}},
+        {R"(<integrator type="prb_projective"><integer name="max_depth" value="4"/><integer name="sppi" value="0"/>
+            <string name="guiding" value="grid"/></integrator>)", "path", {{"max_depth", "4"}}},
+        {R"(<integrator type="direct_projective"><integer name="sppc" value="16"/><boolean name="guiding_proj" value="false"/>
+            </integrator>)", "path", {{"max_depth", "2"}}},
         {R"(<integrator type="direct"><integer name="emitter_samples" value="4"/>
             <boolean name="hide_emitters" value="true"/></integrator>)",
          "path", {{"max_depth", "2"}, {"hide_emitters", "true"}}},

@@ -27,8 +27,9 @@ struct Mapping {
 
 // Mitsuba 3's integrators and their equivalent here. Without participating media (which neepp refuses
 // where a scene declares them) volpath and volpathmis trace what path does; prb and prb_basic are path
-// tracers written for differentiation; direct is next event estimation and BSDF sampling at the first
-// hit only, which path with max_depth 2 is; ptracer is particle tracing, neepp's light.
+// tracers written for differentiation (prb_projective too); direct (and direct_projective, "prb_projective
+// with max_depth 2" in Mitsuba's docs) is next event estimation and BSDF sampling at the first hit only,
+// which path with max_depth 2 is; ptracer is particle tracing, neepp's light.
 const std::map<std::string, Mapping> &mitsuba_integrators() {
     static const std::map<std::string, Mapping> m = {
         {"prb", {"path", -2, {}}},
@@ -37,6 +38,10 @@ const std::map<std::string, Mapping> &mitsuba_integrators() {
         {"volpathmis", {"path", -2, {}}},
         {"direct", {"path", 2, {"emitter_samples", "bsdf_samples", "shading_samples"}}},
         {"ptracer", {"light", -2, {"samples_per_pass"}}},
+        // The projective-sampling integrators differ from prb and direct in their derivatives only; their
+        // own options size and guide the derivative estimates.
+        {"prb_projective", {"path", -2, {"sppc", "sppp", "sppi", "guiding", "guiding_proj", "guiding_rounds"}}},
+        {"direct_projective", {"path", 2, {"sppc", "sppp", "sppi", "guiding", "guiding_proj", "guiding_rounds"}}},
     };
     return m;
 }

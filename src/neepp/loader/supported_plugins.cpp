@@ -19,8 +19,8 @@ const std::vector<std::pair<std::string, std::vector<std::string>>> &supported_p
         // Mitsuba's stratified and low-discrepancy samplers render with neepp's sobol: the same expected image.
         {"sampler", {"independent", "sobol", "stratified", "multijitter", "ldsampler", "orthogonal"}},
         // Mitsuba 3's integrators, each rendered by neepp's own that gives the same image (loader/integrators.cpp).
-        {"integrator", {"path", "bdpt", "light", "pssmlt", "prb", "prb_basic", "volpath", "volpathmis", "direct",
-                        "ptracer", "moment", "aov"}},
+        {"integrator", {"path", "bdpt", "light", "pssmlt", "prb", "prb_basic", "prb_projective", "volpath", "volpathmis",
+                        "direct", "direct_projective", "ptracer", "moment", "aov"}},
     };
     return plugins;
 }
