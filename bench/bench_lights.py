@@ -29,8 +29,9 @@ REPO = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(REPO / "python"))
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
-from bench_neepp import downsample, table  # noqa: E402
+from bench_neepp import table  # noqa: E402
 from neepp_tools import REFERENCES, SCENES_DIR, credit, exr, machine, metrics, report, runner  # noqa: E402
+from neepp_tools.metrics import downsample  # noqa: E402
 
 SAMPLERS = ["power", "uniform", "spatial", "spatial-oriented", "bvh", "visibility", "visibility-power", "visibility-bvh"]
 MANY_LIGHT_SCENES = ["office", "corridor", "courtyard"]

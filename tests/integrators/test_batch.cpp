@@ -1,7 +1,7 @@
 // The path integrator's batched evaluation (Li_batch: paths in lockstep, stage by stage, with
 // prefetches) must be the same computation as Li, path by path: same random numbers in the same order,
 // same result to the bit, whatever the batch's size and however its paths end (escape, absorption,
-// Russian roulette, maximum depth), with plain NEE and with NEE++'s shadow-ray rejection.
+// Russian roulette, maximum depth), with plain NEE, with NEE++'s shadow-ray rejection and with resampled NEE.
 #include <gtest/gtest.h>
 #include "neepp/sampling/sampler.h"
 #include "test_scenes.h"
@@ -72,6 +72,12 @@ TEST(PathIntegratorBatch, SameAsOnePathAtATimeWithNee) { expect_batch_equals_sin
 
 TEST(PathIntegratorBatch, SameAsOnePathAtATimeWithNeepp) {
     expect_batch_equals_single(Options(OptionMap{{"shadow_rays", "neepp"}}));
+}
+
+TEST(PathIntegratorBatch, SameAsOnePathAtATimeWithResampling) {
+    expect_batch_equals_single(Options(OptionMap{{"ris", "4"}}));  // at the first vertex only
+    expect_batch_equals_single(Options(OptionMap{{"ris", "4"}, {"ris_depth", "-1"}}));
+    expect_batch_equals_single(Options(OptionMap{{"ris", "8"}, {"ris_depth", "3"}, {"shadow_rays", "neepp"}, {"light_sampler", "power"}}));
 }
 
 }  // namespace

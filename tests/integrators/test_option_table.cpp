@@ -36,6 +36,7 @@ TEST(OptionTable, EveryListedOptionIsAcceptedWithItsDefault) {
                 std::string needed = o.needs.substr(eq + 1);
                 if (needed.back() == '*') needed.pop_back();  // "neepp*": any NEE++ policy; neepp is one
                 if (needed == "S,T") needed = "2,2";
+                if (needed == "M") needed = "4";  // ris=M: any number of candidates above 1
                 options.set(o.needs.substr(0, eq), needed);
             }
             EXPECT_NO_THROW(make_integrator(d.name, options)) << d.name << " -I " << o.name << "=" << value;
@@ -49,6 +50,7 @@ TEST(OptionTable, EveryOptionTheFactoryReadsIsListed) {
     const std::vector<std::pair<std::string, Map>> configurations = {
         {"path", {{"shadow_rays", "neepp-adaptive"}, {"light_sampler", "visibility"}}},
         {"path", {{"shadow_rays", "neepp"}, {"nee", "true"}}},
+        {"path", {{"ris", "8"}}},
         {"bdpt", {{"light_paths", "neepp"}, {"shadow_rays", "neepp-adaptive"}}},
         {"bdpt", {{"strategy", "1,2"}, {"strategy_weight", "none"}}},
         {"light", {{"shadow_rays", "neepp-adaptive"}}},

@@ -1,8 +1,9 @@
 // Every light sampler on a many-light scene: the pmf sample() reports is exactly what pmf() recomputes
 // (MIS relies on it), selection frequencies follow the pmf (chi-square, with "no light" as an outcome for
-// samplers that may return none), every light that can contribute keeps a nonzero probability, lazily
-// built tables do not depend on which thread built them, and the visibility-aware sampler moves
-// probability toward the lights the map says are visible and follows the map as it learns.
+// samplers that may return none), sample_many is sample for each number (to the bit), every light that
+// can contribute keeps a nonzero probability, lazily built tables do not depend on which thread built
+// them, and the visibility-aware sampler moves probability toward the lights the map says are visible
+// and follows the map as it learns.
 #include <gtest/gtest.h>
 #include <tbb/parallel_for.h>
 #include "common/chi2.h"
@@ -88,6 +89,25 @@ TEST_P(EverySampler, SampleAndPmfAgreeExactly) {
         }
     }
     EXPECT_GT(drawn, 10000);
+}
+
+TEST_P(EverySampler, SampleManyIsSampleForEachNumber) {
+    const auto &[name, env] = GetParam();
+    const Fixture &f = fixture(env);
+    auto sampler = f.make(name);
+    PCG32 rng(31, 7);
+    for (const LightSampleContext &ctx : f.contexts(200, 19))
+        for (int n : {1, 8, 70}) {  // 70: more than the BVH descends at once
+            std::vector<float> u(static_cast<size_t>(n));
+            for (float &x : u) x = rng.next_float();
+            std::vector<SampledLight> many(static_cast<size_t>(n));
+            sampler->sample_many(ctx, u.data(), n, many.data());
+            for (int i = 0; i < n; ++i) {
+                const SampledLight one = sampler->sample(ctx, u[size_t(i)]);
+                ASSERT_EQ(many[size_t(i)].light, one.light) << name << " sample " << i << " of " << n;
+                ASSERT_EQ(many[size_t(i)].pmf, one.pmf) << name << " sample " << i << " of " << n;
+            }
+        }
 }
 
 TEST_P(EverySampler, FrequenciesFollowThePmf) {

@@ -99,7 +99,18 @@ std::unique_ptr<Integrator> make_path(const Options &options) {
         throw std::invalid_argument("within_light must be 'own' or 'visibility', not '" + o.within_light + "'");
     if (o.max_depth < -1 || o.max_depth == 0) throw std::invalid_argument("max_depth must be -1 or >= 1");
     if (o.rr_depth < 1) throw std::invalid_argument("rr_depth must be >= 1");
-    const bool needs_map = light_sampler_needs_visibility_map(o.light_sampler) || o.within_light != "own";
+    o.ris = options.get_int("ris", o.ris);
+    if (o.ris < 1 || o.ris > PathOptions::kMaxCandidates)
+        throw std::invalid_argument("ris must be in [1, " + std::to_string(PathOptions::kMaxCandidates) + "]");
+    if (o.ris > 1) {
+        o.ris_floor = options.get_float("ris_floor", o.ris_floor);
+        o.ris_depth = options.get_int("ris_depth", o.ris_depth);
+        if (o.ris_depth < -1 || o.ris_depth == 0) throw std::invalid_argument("ris_depth must be -1 (all vertices) or >= 1");
+        if (!(o.ris_floor > 0.f && o.ris_floor <= 1.f))
+            throw std::invalid_argument("ris_floor must be in (0, 1]: a target of 0 where light arrives would bias the image");
+    }
+    // Resampling reads the map whatever the light sampler: its target holds Ṽ.
+    const bool needs_map = light_sampler_needs_visibility_map(o.light_sampler) || o.within_light != "own" || o.ris > 1;
     if (o.light_sampler.rfind("spatial", 0) == 0 || needs_map || options.get_string("shadow_rays", "nee") != "nee")
         o.voxels = options.get_int("voxels", o.voxels);
     // A light sampler reading the map needs it from the first pass: no deferred seeding then.

@@ -60,6 +60,12 @@ std::vector<IntegratorDoc> make_docs() {
     path.options.push_back({"within_light", p.within_light,
                             "where on it: own (the light's own sampling) or visibility (environment maps per "
                             "shading voxel by the visibility map)", ""});
+    path.options.push_back({"ris", text(p.ris),
+                            "resampled NEE: M light-sample candidates per vertex, one chosen by f*Le*max(sqrt(V~), "
+                            "ris_floor) for the shadow ray (1: plain NEE; keeps a visibility map)", ""});
+    path.options.push_back({"ris_floor", text(p.ris_floor), "the least sqrt(V~) in the resampling target", "ris=M"});
+    path.options.push_back({"ris_depth", text(p.ris_depth),
+                            "resample at the path's first N vertices only (-1: all), plain NEE beyond", "ris=M"});
     for (OptionDoc o : shadow_ray_options()) {
         if (o.name == "voxels") o.description += " (also the grid of the spatial and visibility light samplers)";
         path.options.push_back(o);

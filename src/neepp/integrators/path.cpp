@@ -1,6 +1,7 @@
 #include "neepp/integrators/path.h"
 
 #include <array>
+#include <cmath>
 #include <memory>
 #include <vector>
 
@@ -28,16 +29,23 @@ PathIntegrator::PathIntegrator(PathOptions options, std::unique_ptr<ShadowRayTes
 
 void PathIntegrator::prepare(const Scene &scene) {
     // The factory keeps a map for a sampler that may read one; on a scene where it does not (one light),
-    // a map that no shadow-ray policy uses either is not built.
+    // a map that no shadow-ray policy uses either is not built. Resampling reads it on any scene.
     if (shadow_->policy() == "nee" && shadow_->visibility_map() &&
         !light_sampler_needs_visibility_map(options_.light_sampler, scene.lights().size()) &&
-        options_.within_light == "own")
+        options_.within_light == "own" && !resampling())
         shadow_ = std::make_unique<TraceAllShadowRays>();
     shadow_->prepare(scene);  // NEE++: build or load the visibility map
     queries_ = &shadow_->query_tester();
     LightSelectionInputs inputs{&scene, shadow_->voxel_grid(), shadow_->visibility_map(), options_.voxels};
     light_sampler_ = make_light_sampler(options_.light_sampler, scene.light_pointers(), inputs);
     within_light_ = WithinLightSampling(options_.within_light, scene, shadow_->voxel_grid(), shadow_->visibility_map());
+    refresh_resampling();
+}
+
+void PathIntegrator::refresh_resampling() {
+    // A map seeded only after the first pass (deferred) is read from the pass after it.
+    if (resampling())
+        resampling_visibility_ = ResamplingVisibility(shadow_->voxel_grid(), shadow_->visibility_map(), options_.ris_floor);
 }
 
 void PathIntegrator::end_pass(const Scene &, const PassStatistics &pass) {
@@ -45,6 +53,7 @@ void PathIntegrator::end_pass(const Scene &, const PassStatistics &pass) {
     queries_ = &shadow_->query_tester();  // ... or, its rejection off, leave the queries to plain NEE
     light_sampler_->end_pass();  // ... and rebuild the light distributions that read it
     within_light_.end_pass();
+    refresh_resampling();
 }
 
 void PathIntegrator::restore_state(const Scene &, const std::string &state) {
@@ -52,6 +61,7 @@ void PathIntegrator::restore_state(const Scene &, const std::string &state) {
     queries_ = &shadow_->query_tester();
     light_sampler_->end_pass();  // its distributions read the restored map
     within_light_.end_pass();
+    refresh_resampling();
 }
 
 nlohmann::json PathIntegrator::statistics() const {
@@ -74,10 +84,19 @@ nlohmann::json PathIntegrator::describe() const {
             {"nee", options_.nee},
             {"light_sampler", options_.light_sampler},
             {"within_light", options_.within_light},
+            {"ris", options_.ris},
+            {"ris_floor", options_.ris_floor},
+            {"ris_depth", options_.ris_depth},
             {"shadow_rays", shadow_->policy()},
             {"shadow_ray_options", shadow_->describe()}};
 }
 
+// The light strategy's density in both MIS weights (here and in begin_direct) is the candidates' source
+// density p = pmf × pdf, with or without resampling. Resampling estimates ∫ g for any g that is 0 where its
+// target is (resampling.h); the light strategy's g is f·Le·V·w_L with w_L = p²/(p² + p_bsdf²), and BSDF
+// sampling estimates ∫ f·Le·V·w_B with w_B the weight below, p_bsdf²/(p² + p_bsdf²). w_L + w_B = 1 at every
+// point, so the two add up to ∫ f·Le·V whatever density enters them: which one only changes the variance
+// (and p, unlike the resampled sample's own density, can be evaluated for a point BSDF sampling found).
 float PathIntegrator::emission_weight(const Light &light, const LightSampleContext &prev, const DirectionSample &ds,
                                       float prev_pdf) const {
     if (!options_.nee) return 1.f;
@@ -85,6 +104,17 @@ float PathIntegrator::emission_weight(const Light &light, const LightSampleConte
     float light_pdf = light_sampler_->pmf(prev, light) * (within ? within->pdf(prev, ds) : light.pdf_direction(prev.p, ds));
     return mis_power(prev_pdf, light_pdf);
 }
+
+struct PathIntegrator::Candidate {
+    SampledLight light;
+    const ContextLightSampler *within = nullptr;  // samples points of the light, if not the light itself
+    LightSampleStart start;  // begun by begin_light, from the light's variates
+    LightSample sample;      // taken by sample_light, alone or in lanes
+    // Resampling only: the BSDF toward the sample, the cell of its light point, its target p̂.
+    BSDFEval bsdf;
+    uint32_t cell = 0;
+    float target = 0;
+};
 
 struct PathIntegrator::Path {
     Sampler *sampler = nullptr;
@@ -100,10 +130,14 @@ struct PathIntegrator::Path {
     SurfaceInteraction si;
     LightSampleContext ctx;
     bool nee = false;
-    SampledLight light;
-    const ContextLightSampler *within = nullptr;  // samples points of the light, if not the light itself
-    LightSampleStart light_start;  // begun by begin_light, from the light's variates
-    LightSample light_sample;  // taken by sample_light, alone or in lanes
+    // m candidate light samples (options_.ris, or 1 where this vertex does not resample), and the one next
+    // event estimation uses.
+    Candidate *candidates = nullptr;
+    int m = 1;
+    int chosen = 0;
+    float u_choice = 0;    // the resampling's variate
+    float ris_weight = 0;  // its weight W = Σw / (M p̂(y))
+    uint32_t cell = 0;     // the shading point's voxel, for the map
     // Next event estimation's shadow query, while its ray waits to be traced with the batch's others.
     ShadowQuery shadow;
     ShadowTest test;
@@ -154,52 +188,126 @@ bool PathIntegrator::begin_vertex(const Scene &scene, Path &path) const {
     bsdf.prefetch(si);
     path.ctx = light_context(si, ray.d);
     path.nee = options_.nee && (si.shape->bsdf_flags & BSDFSmooth);
-    if (path.nee) {
-        path.light = light_sampler_->sample(path.ctx, path.sampler->next_1d());
-        path.within = path.light.light ? within_light_.for_light(*path.light.light) : nullptr;
-        path.light_start.u = path.sampler->next_2d();
-        if (path.within) path.within->prefetch(path.ctx, path.light_start.u);
-        else if (path.light.light) path.light.light->prefetch_sample(path.light_start.u);
+    path.m = options_.ris_depth < 0 || path.depth < options_.ris_depth ? options_.ris : 1;
+    if (!path.nee) return true;
+    const int M = path.m;
+    if (M == 1) {
+        Candidate &c = path.candidates[0];
+        c.light = light_sampler_->sample(path.ctx, path.sampler->next_1d());
+        c.start.u = path.sampler->next_2d();
+    } else {  // each candidate's numbers in the order one candidate takes them, then the choice's; the
+              // lights chosen together (the light BVH's shared descent)
+        float u[PathOptions::kMaxCandidates];
+        SampledLight lights[PathOptions::kMaxCandidates];
+        for (int i = 0; i < M; ++i) {
+            u[i] = path.sampler->next_1d();
+            path.candidates[i].start.u = path.sampler->next_2d();
+        }
+        path.u_choice = path.sampler->next_1d();
+        light_sampler_->sample_many(path.ctx, u, M, lights);
+        for (int i = 0; i < M; ++i) path.candidates[i].light = lights[i];
+    }
+    path.chosen = 0;
+    for (int i = 0; i < M; ++i) {
+        Candidate &c = path.candidates[i];
+        c.within = c.light.light ? within_light_.for_light(*c.light.light) : nullptr;
+        if (c.within) c.within->prefetch(path.ctx, c.start.u);
+        else if (c.light.light) c.light.light->prefetch_sample(c.start.u);
     }
     return true;
 }
 
 void PathIntegrator::begin_light(Path &path) const {
-    if (!path.nee || !path.light.light) return;
-    path.light_start = path.within ? path.within->begin(path.ctx, path.light_start.u)
-                                   : path.light.light->begin_sample(path.light_start.u);
+    if (!path.nee) return;
+    for (int i = 0; i < path.m; ++i) {
+        Candidate &c = path.candidates[i];
+        if (!c.light.light) continue;
+        c.start = c.within ? c.within->begin(path.ctx, c.start.u) : c.light.light->begin_sample(c.start.u);
+    }
 }
 
 void PathIntegrator::sample_light(Path &path, LightSampleLanes &lanes) const {
-    const SampledLight &sl = path.light;
-    path.nee = path.nee && sl.light && sl.pmf > 0;  // from here on: whether there is a sample to use
     if (!path.nee) return;
-    if (path.within)
-        path.light_sample.ds = path.within->finish(path.ctx, path.light_start, path.light_sample.radiance);
-    else if (const LightLaneRecord *record = sl.light->lane_record())
-        lanes.add(*record, path.si.p, path.light_start.u, path.light_sample);
-    else
-        path.light_sample.ds = sl.light->finish_sample(path.si.p, path.light_start, path.light_sample.radiance);
+    bool any = false;  // from here on, path.nee: whether there is a sample to use
+    for (int i = 0; i < path.m; ++i) {
+        Candidate &c = path.candidates[i];
+        const SampledLight &sl = c.light;
+        if (!sl.light || !(sl.pmf > 0)) {
+            c.sample.ds.pdf = 0.f;  // a candidate all the same (resampling counts it), of weight 0
+            continue;
+        }
+        any = true;
+        if (c.within)
+            c.sample.ds = c.within->finish(path.ctx, c.start, c.sample.radiance);
+        else if (const LightLaneRecord *record = sl.light->lane_record())
+            lanes.add(*record, path.si.p, c.start.u, c.sample);
+        else
+            c.sample.ds = sl.light->finish_sample(path.si.p, c.start, c.sample.radiance);
+    }
+    path.nee = any;
+}
+
+void PathIntegrator::weigh_candidates(Path &path) const {
+    if (!path.nee || path.m == 1) return;
+    const SurfaceInteraction &si = path.si;
+    const BSDF &bsdf = *si.shape->bsdf;
+    path.cell = resampling_visibility_.shading_cell(si.p);
+    for (int i = 0; i < path.m; ++i) {
+        Candidate &c = path.candidates[i];
+        const DirectionSample &ds = c.sample.ds;
+        c.target = 0.f;
+        if (!(ds.pdf > 0) || is_black(c.sample.radiance)) continue;
+        c.bsdf = bsdf.eval_pdf(BSDFContext{}, si, si.wi, si.to_local(ds.d));
+        c.target = luminance(c.bsdf.f * c.sample.radiance);
+        if (!(c.target > 0.f)) continue;
+        c.cell = resampling_visibility_.light_cell(ds);
+        resampling_visibility_.prefetch(path.cell, c.cell);  // read by resample, after the batch's other paths
+    }
+}
+
+void PathIntegrator::resample(Path &path) const {
+    if (!path.nee || path.m == 1) return;
+    float w[PathOptions::kMaxCandidates];
+    for (int i = 0; i < path.m; ++i) {
+        Candidate &c = path.candidates[i];
+        w[i] = 0.f;
+        if (!(c.target > 0.f)) continue;
+        c.target *= resampling_visibility_(path.cell, c.cell);
+        const float wi = c.target / (c.light.pmf * c.sample.ds.pdf);
+        if (std::isfinite(wi)) w[i] = wi;
+    }
+    float sum = 0.f;
+    const int s = choose_proportional(w, path.m, path.u_choice, sum);
+    path.nee = s >= 0;
+    if (!path.nee) return;
+    path.chosen = s;
+    path.ris_weight = sum / (float(path.m) * path.candidates[s].target);
 }
 
 bool PathIntegrator::begin_direct(Path &path) const {
     if (!path.nee) return false;
-    const SampledLight &sl = path.light;
+    const Candidate &c = path.candidates[path.chosen];
+    const SampledLight &sl = c.light;
     const SurfaceInteraction &si = path.si;
-    const DirectionSample &ds = path.light_sample.ds;
-    const Color &Le = path.light_sample.radiance;
+    const DirectionSample &ds = c.sample.ds;
+    const Color &Le = c.sample.radiance;
     if (!(ds.pdf > 0) || is_black(Le)) return false;
-    Vec3 wo = si.to_local(ds.d);
     const BSDF &bsdf = *si.shape->bsdf;
-    const auto [f, bsdf_pdf] = bsdf.eval_pdf(BSDFContext{}, si, si.wi, wo);
+    const bool resampled = path.m > 1;
+    const auto [f, bsdf_pdf] = resampled ? c.bsdf : bsdf.eval_pdf(BSDFContext{}, si, si.wi, si.to_local(ds.d));
     if (is_black(f)) return false;
     float light_pdf = ds.pdf * sl.pmf;
-    float w = ds.delta ? 1.f : mis_power(light_pdf, bsdf_pdf);
+    float w = ds.delta ? 1.f : mis_power(light_pdf, bsdf_pdf);  // see emission_weight
     ShadowQuery &q = path.shadow = ShadowQuery{};  // nothing the policy kept from the last bounce
     q.ray = ds.dist >= kInfinity ? si.spawn_ray(ds.d) : si.spawn_ray_to(ds.p);
     q.from = si.p;
     q.to = ds.p;
-    q.unoccluded = path.beta * f * Le * (w / light_pdf);
+    if (resampled) {
+        q.unoccluded = path.beta * f * Le * (w * path.ris_weight);
+        if (resampling_visibility_.uses_map()) q.from_cell = path.cell, q.to_cell = c.cell;  // located already
+    } else {
+        q.unoccluded = path.beta * f * Le * (w / light_pdf);
+    }
     queries_->prepare(q);
     return true;
 }
@@ -250,14 +358,18 @@ void PathIntegrator::Li_batch(const Scene &scene, std::span<const Ray> rays, std
     struct Slots {
         std::array<Path, kBatch> paths;
         std::array<uint32_t, kBatch> active, pending;
+        std::vector<Candidate> candidates;  // each path's options_.ris, one after another
     };
     thread_local std::unique_ptr<Slots> slots;
     if (!slots) slots = std::make_unique<Slots>();
-    auto &[paths, active, pending] = *slots;
+    auto &[paths, active, pending, candidates] = *slots;
+    const size_t M = size_t(options_.ris);
+    if (candidates.size() < kBatch * M) candidates.resize(kBatch * M);
     for (size_t base = 0; base < rays.size(); base += kBatch) {
         const size_t n = std::min(kBatch, rays.size() - base);
         for (size_t i = 0; i < n; ++i) {
             paths[i].start(rays[base + i], samplers[base + i]);
+            paths[i].candidates = &candidates[i * M];
             active[i] = uint32_t(i);
         }
         // Each stage runs over every live path before the next starts, so a prefetch issued for one path
@@ -290,6 +402,10 @@ void PathIntegrator::Li_batch(const Scene &scene, std::span<const Ray> rays, std
             LightSampleLanes light_lanes;
             for (size_t k = 0; k < shading; ++k) sample_light(paths[active[k]], light_lanes);
             light_lanes.flush();
+            if (resampling()) {
+                for (size_t k = 0; k < shading; ++k) weigh_candidates(paths[active[k]]);
+                for (size_t k = 0; k < shading; ++k) resample(paths[active[k]]);
+            }
             // Next event estimation: each policy decides, then the rays it asks for go out as packets.
             size_t querying = 0, tracing = 0;
             for (size_t k = 0; k < shading; ++k)

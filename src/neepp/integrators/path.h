@@ -5,6 +5,7 @@
 #pragma once
 #include <memory>
 #include "neepp/integrators/integrator.h"
+#include "neepp/light_selection/resampling.h"
 #include "neepp/light_selection/within_light_sampling.h"
 #include "neepp/lights/light_sampler.h"
 #include "neepp/visibility/shadow_ray_tester.h"
@@ -21,6 +22,15 @@ struct PathOptions {
     std::string light_sampler = "bvh";  // pbrt-v4's default too; measured best of the non-NEE++ choices (docs/neepp.md)
     std::string within_light = "own";  // how a point on the chosen light is sampled (WithinLightSampling)
     int voxels = 16;  // grid of the spatial light sampler when NEE++ keeps no map (else the map's grid)
+    // Resampled NEE (light_selection/resampling.h): ris light-sample candidates per vertex, one chosen by
+    // f·Le·max(√Ṽ, ris_floor) for the shadow ray (1 = plain NEE), at the path's first ris_depth vertices
+    // (-1: all) and plain NEE beyond. By default at the camera's first hit only: there a candidate costs
+    // what it costs deeper, and it buys the most (deeper vertices' noise is mostly the path's own), so it
+    // was the most efficient depth on every scene measured (docs/neepp.md).
+    static constexpr int kMaxCandidates = 32;
+    int ris = 1;
+    float ris_floor = 0.05f;  // as q_min: a wrong map costs at most a factor 1/ris_floor in a sample's weight
+    int ris_depth = 1;
 };
 
 class PathIntegrator final : public Integrator {
@@ -50,17 +60,22 @@ public:
     ShadowRayTester &shadow_rays() { return *shadow_; }
 
 private:
+    struct Candidate;  // one light sample of next event estimation
     struct Path;  // one path's state between stages
     // Stages of one bounce (see Li_batch). begin_vertex and finish_vertex return false when the path ends.
     bool begin_vertex(const Scene &scene, Path &path) const;
     // Next event estimation at the vertex: begin_light and sample_light sample the light chosen at
     // begin_vertex in two steps (Light::begin_sample, finish_sample), the second eight at a time where the
-    // light allows it (LightSampleLanes: a rectangle of constant radiance); begin_direct forms
+    // light allows it (LightSampleLanes: a rectangle of constant radiance); with resampling (ris > 1) that is
+    // done for each candidate, weigh_candidates evaluates the BSDF toward each and prefetches its map
+    // entry, and resample reads the entries and chooses one; begin_direct forms
     // the shadow query, its contribution MIS-weighted against BSDF sampling and multiplied by the path
     // throughput so contribution-aware policies see all of it (false: it contributes nothing); decide_direct asks the shadow-ray policy
     // and returns true when a ray must be traced, whose outcome end_direct takes.
     void begin_light(Path &path) const;
     void sample_light(Path &path, LightSampleLanes &lanes) const;
+    void weigh_candidates(Path &path) const;
+    void resample(Path &path) const;
     bool begin_direct(Path &path) const;
     bool decide_direct(Path &path, RenderCounters &counters) const;
     void end_direct(Path &path, bool occluded) const;
@@ -70,12 +85,16 @@ private:
     // MIS weight for emission found by a BSDF-sampled ray leaving prev (pdf prev_pdf) toward light.
     float emission_weight(const Light &light, const LightSampleContext &prev, const DirectionSample &ds,
                           float prev_pdf) const;
+    bool resampling() const { return options_.ris > 1; }
+    // The map's share of the resampling target, from the map the coming pass reads.
+    void refresh_resampling();
 
     PathOptions options_;
     std::unique_ptr<ShadowRayTester> shadow_;
     const ShadowRayTester *queries_ = nullptr;  // shadow_->query_tester() for the coming pass
     std::unique_ptr<LightSampler> light_sampler_;
     WithinLightSampling within_light_;
+    ResamplingVisibility resampling_visibility_;
 };
 
 }  // namespace neepp

@@ -160,6 +160,51 @@ SampledLight BVHLightSampler::sample_weighted(const LightSampleContext &ctx, flo
     return {entries_[light].light, pmf};
 }
 
+void BVHLightSampler::sample_many(const LightSampleContext &ctx, const float *u, int n, SampledLight *out) const {
+    // The same operations on each sample's number as sample_weighted's, so the same result to the bit.
+    constexpr int kChunk = 64;
+    const float p_inf = infinite_probability();
+    for (int base = 0; base < n; base += kChunk) {
+        Descent walks[kChunk];
+        int m = 0;
+        for (int i = base; i < std::min(n, base + kChunk); ++i) {
+            float ui = u[i];
+            out[i] = {};
+            if (ui < p_inf) {
+                ui = std::min(ui / p_inf, kOneMinusEpsilon);
+                size_t k = std::min(size_t(ui * float(infinite_.size())), infinite_.size() - 1);
+                out[i] = {infinite_[k], p_inf / float(infinite_.size())};
+            } else if (!nodes_.empty()) {
+                walks[m++] = {std::min((ui - p_inf) / (1 - p_inf), kOneMinusEpsilon), 1 - p_inf, i};
+            }
+        }
+        descend(0, walks, m, ctx, out);
+    }
+}
+
+void BVHLightSampler::descend(uint32_t node, Descent *walks, int n, const LightSampleContext &ctx,
+                              SampledLight *out) const {
+    while (n > 0 && !nodes_[node].leaf) {
+        const float p0 = first_child_probability(node, ctx, nullptr);
+        if (p0 < 0) return;
+        Descent *second = std::partition(walks, walks + n, [&](const Descent &w) { return w.u < p0; });
+        for (Descent *w = walks; w != second; ++w) {
+            w->u = std::min(w->u / p0, kOneMinusEpsilon);
+            w->pmf *= p0;
+        }
+        for (Descent *w = second; w != walks + n; ++w) {
+            w->u = std::min((w->u - p0) / (1 - p0), kOneMinusEpsilon);
+            w->pmf *= 1 - p0;
+        }
+        descend(nodes_[node].child_or_light, second, int(walks + n - second), ctx, out);
+        node = node + 1;
+        n = int(second - walks);
+    }
+    if (n == 0 || !(nodes_[node].bounds.importance(ctx.p, ctx.n) > 0)) return;
+    const Light *light = entries_[nodes_[node].child_or_light].light;
+    for (int k = 0; k < n; ++k) out[walks[k].index] = {light, walks[k].pmf};
+}
+
 float BVHLightSampler::pmf_weighted(const LightSampleContext &ctx, const Light &light, const float *factor) const {
     if (light.index >= entries_.size()) return 0.f;
     const float p_inf = infinite_probability();

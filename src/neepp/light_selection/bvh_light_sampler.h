@@ -15,6 +15,8 @@ class BVHLightSampler final : public LightSampler {
 public:
     explicit BVHLightSampler(std::vector<const Light *> lights);
     SampledLight sample(const LightSampleContext &ctx, float u) const override { return sample_weighted(ctx, u, nullptr); }
+    // One descent for all: each node's importance is computed once for every sample that passes it.
+    void sample_many(const LightSampleContext &ctx, const float *u, int n, SampledLight *out) const override;
     float pmf(const LightSampleContext &ctx, const Light &light) const override { return pmf_weighted(ctx, light, nullptr); }
     std::string name() const override { return "bvh"; }
     nlohmann::json statistics() const override;
@@ -53,6 +55,12 @@ private:
     // Probability of descending from an interior node into its first child (-1: neither child can light
     // ctx). sample and pmf both call it, so their products agree to the bit.
     float first_child_probability(uint32_t node, const LightSampleContext &ctx, const float *factor) const;
+    // sample_many's descent below node of n samples, each with its rescaled number and pmf so far.
+    struct Descent {
+        float u, pmf;
+        int index;  // in sample_many's out
+    };
+    void descend(uint32_t node, Descent *walks, int n, const LightSampleContext &ctx, SampledLight *out) const;
 
     std::vector<const Light *> infinite_;
     std::vector<Node> nodes_;

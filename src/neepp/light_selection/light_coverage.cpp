@@ -21,7 +21,7 @@ std::vector<std::vector<CellWeight>> light_coverage(const VoxelGrid &grid, const
             Color Le;
             DirectionSample ds = lights[l]->sample_direction(reference, u, Le);
             // Area samples facing away from the reference still mark where the light is.
-            const uint32_t cell = ds.dist >= kInfinity ? grid.cell_of_direction(ds.d) : grid.voxel_of(ds.p);
+            const uint32_t cell = grid.cell_of_end(ds.p, ds.d, ds.dist >= kInfinity);
             ++counts[cell];
             ++total;
         }
@@ -45,9 +45,7 @@ float LightVisibility::operator()(uint32_t voxel, const Light &light) const {
     if (light.index >= coverage_.size()) return 1.f;
     double v = 0;
     for (const CellWeight &cw : coverage_[light.index]) {
-        const PairCounts c = map_.counts(voxel, cw.cell);
-        const bool unknown = c.traced == 0 || cw.cell == voxel;
-        v += double(cw.weight) * (unknown ? 1.0 : double(VisibilityMap::estimate(c)));
+        v += double(cw.weight) * double(map_.estimate_or_visible(voxel, cw.cell));
     }
     return float(v);
 }

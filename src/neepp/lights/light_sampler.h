@@ -26,6 +26,12 @@ class LightSampler {
 public:
     virtual ~LightSampler() = default;
     virtual SampledLight sample(const LightSampleContext &ctx, float u) const = 0;
+    // n lights for one shading point, out[i] what sample(ctx, u[i]) returns (to the bit): for resampled
+    // NEE's candidates. Samplers whose choice has work common to all samples (the light BVH's node
+    // importances) do it once.
+    virtual void sample_many(const LightSampleContext &ctx, const float *u, int n, SampledLight *out) const {
+        for (int i = 0; i < n; ++i) out[i] = sample(ctx, u[i]);
+    }
     virtual float pmf(const LightSampleContext &ctx, const Light &light) const = 0;
     virtual std::string name() const = 0;
     // Called between passes, single-threaded: samplers whose tables follow the visibility map rebuild

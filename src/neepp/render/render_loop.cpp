@@ -2,6 +2,7 @@
 
 #include <chrono>
 #include <cmath>
+#include <ctime>
 #include <memory>
 #include <mutex>
 #include <tbb/enumerable_thread_specific.h>
@@ -20,6 +21,12 @@ namespace neepp {
 namespace {
 
 using Clock = std::chrono::steady_clock;
+
+double process_cpu_time_s() {
+    timespec t{};
+    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
+    return double(t.tv_sec) + 1e-9 * double(t.tv_nsec);
+}
 
 // Camera samples handed to the integrator at once (Integrator::Li_batch).
 constexpr int kBatch = 32;
@@ -119,6 +126,7 @@ RenderResult render(const Scene &scene, Integrator &integrator, const RenderJob 
     RenderResult result;
     tbb::enumerable_thread_specific<RenderCounters> counters;
     const Clock::time_point start = Clock::now();
+    const double cpu_start = process_cpu_time_s();
     const double time_before = job.resume ? job.resume->render_time_s : 0.0;  // a resumed render's earlier time
     auto elapsed = [&] { return time_before + std::chrono::duration<double>(Clock::now() - start).count(); };
 
@@ -321,6 +329,7 @@ RenderResult render(const Scene &scene, Integrator &integrator, const RenderJob 
     bar.finish();
 
     result.render_time_s = elapsed();
+    result.render_cpu_time_s = process_cpu_time_s() - cpu_start;
     result.counters = counted();
     result.occlusion_time_s = double(result.counters.occlusion_ticks) * seconds_per_tick();
     result.image = current_image();

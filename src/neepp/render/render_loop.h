@@ -53,6 +53,9 @@ struct RenderResult {
     int spp = 0;                   // samples per pixel actually in the image
     int passes = 0;
     double render_time_s = 0;
+    // CPU time of all the process's threads over the same span (this run's only, when resumed): with one
+    // thread, a measure of the work that other processes on a shared machine do not inflate.
+    double render_cpu_time_s = 0;
     RenderCounters counters;
     double occlusion_time_s = 0;
     std::string stopped_by = "spp";  // spp, time, cancel

@@ -42,6 +42,7 @@ nlohmann::json render_statistics(const Scene &scene, const Integrator &integrato
         {"threads", job.threads},
         {"sampler", job.sampler},
         {"render_time_s", r.render_time_s},
+        {"render_cpu_time_s", r.render_cpu_time_s},
         {"samples_per_s", r.render_time_s > 0 ? samples / r.render_time_s : 0.0},
         {"rays", c.rays},
         {"camera_rays", c.rays - c.light_rays},

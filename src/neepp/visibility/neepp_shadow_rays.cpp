@@ -59,7 +59,7 @@ float NeeppShadowRays::trace_probability(PairCounts c, bool same_cell, float lum
 std::pair<uint32_t, uint32_t> NeeppShadowRays::cells_of(const ShadowQuery &q) const {
     if (q.from_cell != ShadowQuery::kUnknownCell) return {q.from_cell, q.to_cell};
     const bool to_infinity = q.ray.tmax >= kInfinity;
-    return {grid_.voxel_of(q.from), to_infinity ? grid_.cell_of_direction(q.ray.d) : grid_.voxel_of(q.to)};
+    return {grid_.voxel_of(q.from), grid_.cell_of_end(q.to, q.ray.d, to_infinity)};
 }
 
 void NeeppShadowRays::prepare(ShadowQuery &q) const {

@@ -38,6 +38,12 @@ public:
     // (an unseen outcome is never declared impossible). Unknown pairs give 0.5 here; callers check known().
     static float estimate(PairCounts c) { return (float(c.visible) + 1.f) / (float(c.traced) + 2.f); }
     float estimate(uint32_t a, uint32_t b) const { return estimate(counts(a, b)); }
+    // Ṽ(a, b) where the map can tell, else 1: a pair never traced, and a cell with itself (whose
+    // visibility the map cannot resolve), count as visible. What the map's readers weigh by.
+    float estimate_or_visible(uint32_t a, uint32_t b) const {
+        const PairCounts c = counts(a, b);
+        return c.traced == 0 || a == b ? 1.f : estimate(c);
+    }
 
     // Adds outcomes to a pair. When traced would exceed 65535 both counts are halved (repeatedly) so the
     // ratio survives and old evidence slowly fades. The result depends only on the old counts and the

@@ -42,6 +42,11 @@ public:
     }
     // The direction-bin cell of a (not necessarily unit) direction.
     uint32_t cell_of_direction(const Vec3 &d) const;
+    // The cell of a shadow ray's far end: the voxel of `to`, or, toward an infinite light (no end point),
+    // the direction bin of d.
+    uint32_t cell_of_end(const Vec3 &to, const Vec3 &d, bool to_infinity) const {
+        return to_infinity ? cell_of_direction(d) : voxel_of(to);
+    }
     // Integer coordinates of a voxel cell.
     void voxel_coords(uint32_t cell, int &x, int &y, int &z) const;
     // A direction uniformly distributed over the cube-map bin's face patch (not uniform in solid angle;
