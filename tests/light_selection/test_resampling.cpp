@@ -59,7 +59,7 @@ TEST(Resampling, NothingToChooseFromAndTheEdges) {
 }
 
 TEST(Resampling, TargetVisibilityIsTheRootOfTheMapsEstimateAboveTheFloor) {
-    const VoxelGrid grid(BBox(Vec3(0.f), Vec3(1.f)), 4);
+    const VoxelGrid grid(BBox{Vec3(0.f), Vec3(1.f)}, 4);
     VisibilityMap map(grid.cell_count());
     map.set(1, 2, PairCounts{0, 398});  // Ṽ = 1/400, √Ṽ = 0.05: below the floor
     map.set(1, 3, PairCounts{48, 98});  // Ṽ = 0.49
