@@ -26,7 +26,7 @@ struct PathOptions {
     // f·Le·max(√Ṽ, ris_floor) for the shadow ray (1 = plain NEE), at the path's first ris_depth vertices
     // (-1: all) and plain NEE beyond. By default at the camera's first hit only: there a candidate costs
     // what it costs deeper, and it buys the most (deeper vertices' noise is mostly the path's own), so it
-    // was the most efficient depth on every scene measured (docs/neepp.md).
+    // was the most efficient depth on six of the seven scenes measured (docs/neepp.md).
     static constexpr int kMaxCandidates = 32;
     int ris = 1;
     float ris_floor = 0.05f;  // as q_min: a wrong map costs at most a factor 1/ris_floor in a sample's weight
