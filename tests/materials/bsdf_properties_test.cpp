@@ -10,6 +10,7 @@
 #include "neepp/materials/normalmap.h"
 #include "neepp/materials/plastic.h"
 #include "neepp/materials/roughconductor.h"
+#include "neepp/materials/pplastic.h"
 #include "neepp/materials/roughplastic.h"
 #include "neepp/materials/thindielectric.h"
 #include "neepp/materials/bumpmap.h"
@@ -35,6 +36,10 @@ std::vector<BSDFPtr> glossy_bsdfs() {
             std::make_shared<RoughPlasticBSDF>(MicrofacetType::Beckmann, 0.5f, 1.49f, 1.f, constant_texture(0.6f),
                                                nullptr, true),
             std::make_shared<PlasticBSDF>(1.49f, 1.f, constant_texture(Color(0.8f, 0.3f, 0.1f))),
+            std::make_shared<PolarizedPlasticBSDF>(MicrofacetType::Beckmann, constant_texture(0.25f), constant_texture(0.25f),
+                                                   1.49f, constant_texture(Color(0.9f, 0.5f, 0.2f))),
+            std::make_shared<PolarizedPlasticBSDF>(MicrofacetType::GGX, constant_texture(0.4f), constant_texture(0.15f),
+                                                   1.7f, constant_texture(1.f), constant_texture(0.8f), false),
             std::make_shared<BlendBSDF>(constant_texture(0.3f), std::make_shared<DiffuseBSDF>(constant_texture(0.7f)),
                                         rough_conductor(MicrofacetType::GGX, 0.2f, 0.2f, 0.2f, 3.9f)),
             std::make_shared<BlendBSDF>(constant_texture(0.6f), std::make_shared<DiffuseBSDF>(constant_texture(0.5f)),

@@ -14,6 +14,7 @@
 #include "neepp/materials/normalmap.h"
 #include "neepp/materials/plastic.h"
 #include "neepp/materials/roughconductor.h"
+#include "neepp/materials/pplastic.h"
 #include "neepp/materials/roughplastic.h"
 
 namespace neepp::test {
@@ -79,6 +80,15 @@ std::vector<Case> make_cases() {
         return std::make_shared<RoughPlasticBSDF>(MicrofacetType::Beckmann, 0.3f, 1.7f, 1.f, constant_texture(0.7f),
                                                   nullptr, true, false);
     }, {45.f});
+    // pplastic: its own mixture (specular weight only, two smooth Fresnel transmissions on the diffuse lobe).
+    add("pplastic_beckmann_default", [] {
+        auto a = constant_texture(0.1f);
+        return std::make_shared<PolarizedPlasticBSDF>(MicrofacetType::Beckmann, a, a, 1.49f, constant_texture(0.5f));
+    }, {0.f, 60.f, 85.f});
+    add("pplastic_ggx_aniso_allnormals", [] {
+        return std::make_shared<PolarizedPlasticBSDF>(MicrofacetType::GGX, constant_texture(0.3f), constant_texture(0.1f),
+                                                      1.6f, constant_texture(Color(0.05f, 0.03f, 0.1f)), nullptr, false);
+    }, {30.f, 75.f});
     add("plastic", [] { return std::make_shared<PlasticBSDF>(1.49f, 1.f, constant_texture(0.5f)); }, {10.f, 80.f});
 
     // blendbsdf: the pick by weight and the blended pdf. A float weight, a texture one (the checkerboard's

@@ -18,6 +18,7 @@
 #include "neepp/materials/principledthin.h"
 #include "neepp/materials/roughconductor.h"
 #include "neepp/materials/roughdielectric.h"
+#include "neepp/materials/pplastic.h"
 #include "neepp/materials/roughplastic.h"
 #include "neepp/materials/thindielectric.h"
 
@@ -49,6 +50,7 @@ const Query kQueries[] = {
 #include "principled_reference.inc"
 #include "roughdielectric_reference.inc"
 #include "hair_reference.inc"
+#include "pplastic_reference.inc"
 };
 
 TexturePtr tex(float v) { return constant_texture(v); }
@@ -136,6 +138,13 @@ std::map<std::string, BSDFPtr> make_bsdfs() {
         p.spec_trans = tex(0.4f), p.diff_trans = tex(0.6f), p.anisotropic = tex(0.5f), p.roughness = tex(0.3f);
         p.eta = tex(1.3f), p.spec_tint = tex(0.2f), p.sheen = tex(0.3f), p.flatness = tex(0.2f);
     });
+    // pplastic: the configurations of generate_pplastic_reference.py.
+    m["pplastic_default"] = std::make_shared<PolarizedPlasticBSDF>(MicrofacetType::Beckmann, tex(0.1f), tex(0.1f),
+                                                                   pp / air, tex(0.5f));
+    m["pplastic_docs"] = std::make_shared<PolarizedPlasticBSDF>(MicrofacetType::Beckmann, tex(0.06f), tex(0.06f),
+                                                                pp / air, tex(Color(0.05f, 0.03f, 0.1f)));
+    m["pplastic_ggx_aniso_novis"] = std::make_shared<PolarizedPlasticBSDF>(
+        MicrofacetType::GGX, tex(0.3f), tex(0.1f), 1.6f, tex(Color(0.7f, 0.4f, 0.2f)), tex(0.8f), false);
     // hair: the configurations of generate_hair_reference.py (amber in air unless said).
     auto hair = [](Color sigma_a, const std::function<void(HairParams &)> &set = [](HairParams &) {}) {
         HairParams p;

@@ -15,6 +15,7 @@
 #include "neepp/materials/principledthin.h"
 #include "neepp/materials/roughconductor.h"
 #include "neepp/materials/roughdielectric.h"
+#include "neepp/materials/pplastic.h"
 #include "neepp/materials/roughplastic.h"
 #include "neepp/materials/thindielectric.h"
 #include "neepp/materials/twosided.h"
@@ -27,6 +28,19 @@ MicrofacetType distribution_param(const XmlNode &node) {
     auto t = parse_microfacet_type(name);
     if (!t) throw node.error("unknown microfacet distribution '" + name + "' (beckmann, ggx)");
     return *t;
+}
+
+// Mitsuba's microfacet roughness: `alpha`, or both `alpha_u` and `alpha_v` (anisotropic), each a float or
+// a texture; 0.1 when none is given.
+std::pair<TexturePtr, TexturePtr> roughness_params(Factories &f, const XmlNode &node) {
+    const bool has_u = node.has("alpha_u") || node.child("alpha_u"), has_v = node.has("alpha_v") || node.child("alpha_v");
+    if (!has_u && !has_v) {
+        TexturePtr a = f.texture_param(node, "alpha", Color(0.1f), true);
+        return {a, a};
+    }
+    if (!has_u || !has_v) throw node.error("give both 'alpha_u' and 'alpha_v'");
+    if (node.has("alpha") || node.child("alpha")) throw node.error("give either 'alpha' or 'alpha_u'/'alpha_v'");
+    return {f.texture_param(node, "alpha_u", Color(0.1f), true), f.texture_param(node, "alpha_v", Color(0.1f), true)};
 }
 
 // Mitsuba's conductor parameters: a named `material` or explicit `eta`/`k`.
@@ -193,6 +207,10 @@ BSDFPtr Factories::create_bsdf(const XmlNode &node) {
         b = std::make_shared<TwoSidedBSDF>(bsdf(*kids[0]), kids.size() > 1 ? bsdf(*kids[1]) : nullptr);
     } else if (t == "null") {
         b = std::make_shared<NullBSDF>();
+    } else if (t == "polarizer") {
+        // The polarizer's angle changes nothing for unpolarized light: read only so that it is not "unused".
+        texture_param(node, "theta", Color(0.f), true);
+        b = std::make_shared<PolarizerBSDF>(texture_param(node, "transmittance", Color(1.f)));
     } else if (t == "mask") {
         auto kids = nested(1, 1);
         b = std::make_shared<MaskBSDF>(texture_param(node, "opacity", Color(0.5f)), bsdf(*kids[0]));
@@ -219,14 +237,7 @@ BSDFPtr Factories::create_bsdf(const XmlNode &node) {
         b = std::make_shared<ConductorBSDF>(eta, k, texture_param_or_null(node, "specular_reflectance"));
     } else if (t == "roughconductor") {
         auto [eta, k] = conductor_ior(*this, node);
-        TexturePtr au, av;
-        if (node.has("alpha_u") || node.child("alpha_u")) {
-            if (node.has("alpha") || node.child("alpha")) throw node.error("give either 'alpha' or 'alpha_u'/'alpha_v'");
-            au = texture_param(node, "alpha_u", Color(0.1f), true);
-            av = texture_param(node, "alpha_v", Color(0.1f), true);
-        } else {
-            au = av = texture_param(node, "alpha", Color(0.1f), true);
-        }
+        auto [au, av] = roughness_params(*this, node);
         b = std::make_shared<RoughConductorBSDF>(distribution_param(node), au, av, eta, k,
                                                  texture_param_or_null(node, "specular_reflectance"),
                                                  node.get_bool("sample_visible", true));
@@ -241,6 +252,20 @@ BSDFPtr Factories::create_bsdf(const XmlNode &node) {
                                                texture_param(node, "diffuse_reflectance", Color(0.5f)),
                                                texture_param_or_null(node, "specular_reflectance"),
                                                node.get_bool("nonlinear", false), node.get_bool("sample_visible", true));
+    } else if (t == "pplastic") {
+        auto [au, av] = roughness_params(*this, node);
+        float eta;
+        if (node.has("eta")) {
+            if (node.has("int_ior") || node.has("ext_ior")) throw node.error("give either 'eta' or 'int_ior'/'ext_ior', not both");
+            eta = node.get_float("eta", 1.5f);
+        } else {
+            eta = ior_param(node, "int_ior", 1.49f) / ior_param(node, "ext_ior", 1.000277f);
+        }
+        if (!(eta > 0.f) || eta == 1.f) throw node.error("the interior and exterior indices of refraction must be positive and differ");
+        b = std::make_shared<PolarizedPlasticBSDF>(distribution_param(node), au, av, eta,
+                                                   texture_param(node, "diffuse_reflectance", Color(0.5f)),
+                                                   texture_param_or_null(node, "specular_reflectance"),
+                                                   node.get_bool("sample_visible", true));
     } else if (t == "dielectric" || t == "thindielectric") {
         float int_ior = ior_param(node, "int_ior", 1.5046f), ext_ior = ior_param(node, "ext_ior", 1.000277f);
         TexturePtr r = texture_param_or_null(node, "specular_reflectance");
@@ -248,16 +273,7 @@ BSDFPtr Factories::create_bsdf(const XmlNode &node) {
         if (t == "dielectric") b = std::make_shared<DielectricBSDF>(int_ior, ext_ior, r, tr);
         else b = std::make_shared<ThinDielectricBSDF>(int_ior, ext_ior, r, tr);
     } else if (t == "roughdielectric") {
-        TexturePtr au, av;
-        const bool has_u = node.has("alpha_u") || node.child("alpha_u"), has_v = node.has("alpha_v") || node.child("alpha_v");
-        if (has_u || has_v) {
-            if (!has_u || !has_v) throw node.error("give both 'alpha_u' and 'alpha_v'");
-            if (node.has("alpha") || node.child("alpha")) throw node.error("give either 'alpha' or 'alpha_u'/'alpha_v'");
-            au = texture_param(node, "alpha_u", Color(0.1f), true);
-            av = texture_param(node, "alpha_v", Color(0.1f), true);
-        } else {
-            au = av = texture_param(node, "alpha", Color(0.1f), true);
-        }
+        auto [au, av] = roughness_params(*this, node);
         const float int_ior = ior_param(node, "int_ior", 1.5046f), ext_ior = ior_param(node, "ext_ior", 1.000277f);
         if (int_ior == ext_ior) throw node.error("'int_ior' and 'ext_ior' must differ");
         b = std::make_shared<RoughDielectricBSDF>(distribution_param(node), au, av, int_ior, ext_ior,

@@ -10,7 +10,7 @@ const std::vector<std::pair<std::string, std::vector<std::string>>> &supported_p
                    "linearcurve", "bsplinecurve", "shapegroup", "instance"}},
         {"bsdf", {"diffuse", "twosided", "mask", "bumpmap", "conductor", "roughconductor", "plastic", "roughplastic",
                   "dielectric", "roughdielectric", "thindielectric", "principled", "principledthin", "null", "normalmap",
-                  "blendbsdf", "hair"}},
+                  "blendbsdf", "hair", "pplastic", "polarizer"}},
         {"texture", {"bitmap", "checkerboard", "rawconstant", "mesh_attribute"}},
         {"emitter", {"area", "envmap", "constant", "point", "spot", "directional", "projector"}},
         {"sensor", {"perspective", "orthographic"}},

@@ -40,6 +40,29 @@ public:
     uint32_t flags() const override { return BSDFNull; }
 };
 
+// Mitsuba's `polarizer` (a linear polarizer) as its RGB variants render it: with unpolarized light every
+// ray passes straight through carrying half the `transmittance` (Mitsuba: 0.5 * transmittance), whatever
+// the polarizer's angle `theta`; only polarized variants see the angle.
+class PolarizerBSDF final : public BSDF {
+public:
+    explicit PolarizerBSDF(TexturePtr transmittance) : transmittance_(std::move(transmittance)) {}
+    Color eval(const BSDFContext &, const SurfaceInteraction &, const Vec3 &, const Vec3 &) const override { return Color(0.f); }
+    float pdf(const BSDFContext &, const SurfaceInteraction &, const Vec3 &, const Vec3 &) const override { return 0.f; }
+    BSDFSample sample(const BSDFContext &, const SurfaceInteraction &si, const Vec3 &wi, float, Vec2) const override {
+        BSDFSample bs;
+        bs.wo = -wi;
+        bs.pdf = 1.f;
+        bs.sampled_flags = BSDFNull;
+        bs.weight = transmittance_->eval(si) * 0.5f;
+        return bs;
+    }
+    uint32_t flags() const override { return BSDFNull; }
+    void prefetch(const SurfaceInteraction &si) const override { transmittance_->prefetch(si); }
+
+private:
+    TexturePtr transmittance_;
+};
+
 class MaskBSDF final : public BSDF {
 public:
     MaskBSDF(TexturePtr opacity, BSDFPtr nested) : opacity_(std::move(opacity)), nested_(std::move(nested)) {}
