@@ -71,6 +71,14 @@ def mitsuba_render(xml, out, spp: int, seed: int):
     return exr.read_exr(out)[..., :3]
 
 
+def scene_and_mitsuba(folder, name: str, scene: str, out_dir, spp: int = 1024, seed: int = 1):
+    """Writes the scene text to folder/NAME.xml and renders it with Mitsuba 3 into out_dir: (xml, image), the
+    module-scoped fixture of an image test against Mitsuba."""
+    xml = folder / f"{name}.xml"
+    xml.write_text(scene)
+    return xml, mitsuba_render(xml, out_dir / f"mitsuba_{name}.exr", spp=spp, seed=seed)
+
+
 def assert_agrees(img, ref, what, mean_tol: float = 0.01, region_tol: float = 0.02):
     img, ref = img[..., :3], ref[..., :3]
     m, mr = metrics.image_mean(img), metrics.image_mean(ref)

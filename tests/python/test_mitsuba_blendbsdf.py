@@ -12,7 +12,7 @@ from __future__ import annotations
 
 import pytest
 
-from mitsuba_compare import mitsuba_render, neepp_agrees, sensor
+from mitsuba_compare import neepp_agrees, scene_and_mitsuba, sensor
 from neepp_tools import REPO_ROOT
 
 OUT = REPO_ROOT / ".cache" / "test_mitsuba_blendbsdf"
@@ -42,9 +42,8 @@ SCENE = """<scene version="3.0.0">
 
 @pytest.fixture(scope="module")
 def scene_and_reference(tmp_path_factory):
-    xml = tmp_path_factory.mktemp("blendbsdf") / "blend.xml"
-    xml.write_text(SCENE.replace("@SENSOR@", sensor(45, "0,2.5,2.5", "0,0.3,0")))
-    return xml, mitsuba_render(xml, OUT / "mitsuba_blend.exr", spp=1024, seed=1)
+    return scene_and_mitsuba(tmp_path_factory.mktemp("blendbsdf"), "blend",
+                             SCENE.replace("@SENSOR@", sensor(45, "0,2.5,2.5", "0,0.3,0")), OUT)
 
 
 @pytest.mark.parametrize("integrator", ["path", "bdpt"])

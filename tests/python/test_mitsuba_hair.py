@@ -18,7 +18,7 @@ from __future__ import annotations
 
 import pytest
 
-from mitsuba_compare import mitsuba_render, neepp_agrees, sensor
+from mitsuba_compare import neepp_agrees, scene_and_mitsuba, sensor
 from neepp_tools import REPO_ROOT
 
 OUT = REPO_ROOT / ".cache" / "test_mitsuba_hair"
@@ -46,9 +46,8 @@ SCENE = """<scene version="3.0.0">
 
 @pytest.fixture(scope="module")
 def scene_and_reference(tmp_path_factory):
-    xml = tmp_path_factory.mktemp("hair") / "hair.xml"
-    xml.write_text(SCENE.replace("@SENSOR@", sensor(40, "0,0.3,3", "0.1,0,0")))
-    return xml, mitsuba_render(xml, OUT / "mitsuba_hair.exr", spp=1024, seed=1)
+    return scene_and_mitsuba(tmp_path_factory.mktemp("hair"), "hair",
+                             SCENE.replace("@SENSOR@", sensor(40, "0,0.3,3", "0.1,0,0")), OUT)
 
 
 # Samples per pixel, each render a few seconds on two cores.

@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import pytest
 
-from mitsuba_compare import mitsuba_render, neepp_agrees, sensor
+from mitsuba_compare import neepp_agrees, scene_and_mitsuba, sensor
 from neepp_tools import REPO_ROOT
 
 OUT = REPO_ROOT / ".cache" / "test_mitsuba_pplastic_polarizer"
@@ -40,9 +40,8 @@ SCENE = """<scene version="3.0.0">
 
 @pytest.fixture(scope="module")
 def scene_and_reference(tmp_path_factory):
-    xml = tmp_path_factory.mktemp("pplastic") / "pplastic.xml"
-    xml.write_text(SCENE.replace("@SENSOR@", sensor(45, "0.5,2.2,3", "0,0.4,0")))
-    return xml, mitsuba_render(xml, OUT / "mitsuba_pplastic.exr", spp=1024, seed=1)
+    return scene_and_mitsuba(tmp_path_factory.mktemp("pplastic"), "pplastic",
+                             SCENE.replace("@SENSOR@", sensor(45, "0.5,2.2,3", "0,0.4,0")), OUT)
 
 
 @pytest.mark.parametrize("integrator", ["path", "bdpt"])
