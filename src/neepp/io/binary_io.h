@@ -11,6 +11,15 @@
 
 namespace neepp {
 
+// The value of type T stored at byte `at` of `data`, in this machine's byte order; the caller has checked
+// that sizeof(T) bytes are there (the mesh and volume readers check a whole header at once).
+template <typename T> T load_at(const std::string &data, size_t at) {
+    static_assert(std::is_trivially_copyable_v<T>);
+    T v;
+    std::memcpy(&v, data.data() + at, sizeof(T));
+    return v;
+}
+
 struct BinaryWriter {
     std::string bytes;
     template <typename T> void put(const T &v) {

@@ -2,6 +2,7 @@
 // 4). Mitsuba reads the zlib stream only as far as it needs, so this does too: bytes after the last
 // array (another mesh, the offset table) are never inflated.
 #include "neepp/io/serialized_reader.h"
+#include "neepp/io/binary_io.h"
 
 #include <algorithm>
 #include <bit>
@@ -19,12 +20,6 @@ constexpr uint32_t kHasNormals = 0x0001, kHasTexcoords = 0x0002, kHasColors = 0x
 // Deflate expands at most about 1032:1; a count that would need more output than the rest of the file
 // can hold is a corrupt header, refused before it reaches an allocation.
 constexpr double kMaxInflateRatio = 1100;
-
-template <typename T> T load(const std::string &data, size_t at) {
-    T v;
-    std::memcpy(&v, data.data() + at, sizeof(T));
-    return v;
-}
 
 // The zlib stream of one mesh, inflated on demand.
 class Inflater {
@@ -97,7 +92,7 @@ std::vector<Vec3> read_vec3s(Inflater &in, bool double_precision, size_t count) 
 size_t mesh_offset(const std::string &data, int shape_index, uint16_t version, const std::string &path) {
     if (shape_index == 0) return 0;  // as Mitsuba, the first mesh is read without the table
     const size_t size = data.size();
-    const uint32_t count = load<uint32_t>(data, size - 4);
+    const uint32_t count = load_at<uint32_t>(data, size - 4);
     if (uint32_t(shape_index) >= count)
         throw SceneError(path, "shape_index " + std::to_string(shape_index) + " is out of range: the file holds " +
                                    std::to_string(count) + (count == 1 ? " mesh" : " meshes"));
@@ -105,8 +100,8 @@ size_t mesh_offset(const std::string &data, int shape_index, uint16_t version, c
     const size_t table = size_t(count) * entry + 4;
     if (table > size) throw SceneError(path, "corrupt .serialized file (its offset table is larger than the file)");
     const size_t at = size - table + size_t(shape_index) * entry;
-    const uint64_t offset = version == 4 ? load<uint64_t>(data, at) : load<uint32_t>(data, at);
-    if (offset > size - table || size - table - offset < 4 || load<uint16_t>(data, offset) != kMagic)
+    const uint64_t offset = version == 4 ? load_at<uint64_t>(data, at) : load_at<uint32_t>(data, at);
+    if (offset > size - table || size - table - offset < 4 || load_at<uint16_t>(data, offset) != kMagic)
         throw SceneError(path, "corrupt .serialized file (the offset table entry of mesh " + std::to_string(shape_index) +
                                    " points to no mesh)");
     return size_t(offset);
@@ -118,8 +113,8 @@ MeshData read_serialized(const std::string &path, int shape_index) {
     if (shape_index < 0) throw SceneError(path, "shape_index must be non-negative (got " + std::to_string(shape_index) + ")");
     const std::string data = mesh_detail::read_file(path);
     if (data.size() < 4) throw SceneError(path, "truncated .serialized file (no header)");
-    if (load<uint16_t>(data, 0) != kMagic) throw SceneError(path, "not a Mitsuba .serialized file (bad magic number)");
-    const uint16_t version = load<uint16_t>(data, 2);
+    if (load_at<uint16_t>(data, 0) != kMagic) throw SceneError(path, "not a Mitsuba .serialized file (bad magic number)");
+    const uint16_t version = load_at<uint16_t>(data, 2);
     if (version != 3 && version != 4)
         throw SceneError(path, "unsupported .serialized version " + std::to_string(version) +
                                    " (Mitsuba 3 up to 3.9 reads versions 3 and 4)");

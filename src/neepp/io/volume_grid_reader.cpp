@@ -15,12 +15,6 @@ static_assert(std::endian::native == std::endian::little, "the .vol reader assum
 
 constexpr size_t kHeaderBytes = 3 + 1 + 4 * 5 + 4 * 6;
 
-template <typename T> T load(const std::string &data, size_t at) {
-    T v;
-    std::memcpy(&v, data.data() + at, sizeof(T));
-    return v;
-}
-
 }  // namespace
 
 VolumeGrid read_volume_grid(const std::string &path) {
@@ -35,11 +29,12 @@ VolumeGrid read_volume_grid(const std::string &path) {
     if (const int version = uint8_t(data[3]); version != 3)
         throw SceneError(path, "volume grid file version " + std::to_string(version) + " (only version 3 is supported)");
     if (data.size() < kHeaderBytes) throw SceneError(path, "truncated volume grid file (the header ends early)");
-    if (const int32_t type = load<int32_t>(data, 4); type != 1)
+    if (const int32_t type = load_at<int32_t>(data, 4); type != 1)
         throw SceneError(path, "volume grid data type " + std::to_string(type) +
                                    " (only type 1, float32, is supported, as in Mitsuba 3)");
     VolumeGrid g;
-    const int32_t dims[4] = {load<int32_t>(data, 8), load<int32_t>(data, 12), load<int32_t>(data, 16), load<int32_t>(data, 20)};
+    const int32_t dims[4] = {load_at<int32_t>(data, 8), load_at<int32_t>(data, 12), load_at<int32_t>(data, 16),
+                             load_at<int32_t>(data, 20)};
     if (dims[0] < 1 || dims[1] < 1 || dims[2] < 1)
         throw SceneError(path, "volume grid size " + std::to_string(dims[0]) + " x " + std::to_string(dims[1]) + " x " +
                                    std::to_string(dims[2]) + " is invalid (each must be at least 1)");

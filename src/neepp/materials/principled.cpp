@@ -10,8 +10,6 @@ namespace neepp {
 
 namespace {
 
-float eval_or_zero(const TexturePtr &t, const SurfaceInteraction &si) { return t ? t->eval_1(si) : 0.f; }
-
 float lerp(float a, float b, float t) { return a * (1.f - t) + b * t; }
 
 // Clearcoat's shadowing: Smith GGX at a fixed alpha of 0.25, as Burley.

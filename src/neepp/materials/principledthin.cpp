@@ -8,12 +8,6 @@
 
 namespace neepp {
 
-namespace {
-
-float eval_or_zero(const TexturePtr &t, const SurfaceInteraction &si) { return t ? t->eval_1(si) : 0.f; }
-
-}  // namespace
-
 PrincipledThinBSDF::PrincipledThinBSDF(PrincipledThinParams p) : p_(std::move(p)) {
     if (!p_.base_color) p_.base_color = constant_texture(0.5f);
     if (!p_.roughness) p_.roughness = constant_texture(0.5f);

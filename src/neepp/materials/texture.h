@@ -41,6 +41,10 @@ private:
 };
 
 using TexturePtr = std::shared_ptr<const Texture>;
+
+// A scalar texture's value, 0 where it is not set (a BSDF's optional parameters, such as principled's).
+inline float eval_or_zero(const TexturePtr &t, const SurfaceInteraction &si) { return t ? t->eval_1(si) : 0.f; }
+
 inline TexturePtr constant_texture(Color c) { return std::make_shared<ConstantTexture>(c); }
 inline TexturePtr constant_texture(float v) { return std::make_shared<ConstantTexture>(Color(v)); }
 
