@@ -2,8 +2,8 @@
 # The C++ test suite under AddressSanitizer + UndefinedBehaviorSanitizer: out-of-bounds reads and writes,
 # use after free, leaks, signed overflow, misaligned or null accesses, bad shifts and casts each fail
 # the test that trips them. One clang build (build-sanitize/) serves this and the fuzz targets
-# (scripts/fuzz.sh): for x86-64-v3, so it runs alike on any AVX2 or AVX-512 machine, at -O1, so it
-# builds quickly. scripts/test.sh runs it. Usage: scripts/test_sanitizers.sh [ctest arguments]
+# (scripts/fuzz.sh): for x86-64-v3, so it runs alike on any AVX2 or AVX-512 machine (the optimization
+# level: scripts/build_sanitized.sh). scripts/test.sh runs it. Usage: scripts/test_sanitizers.sh [ctest arguments]
 set -euo pipefail
 ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 "$ROOT/scripts/build_sanitized.sh"

@@ -35,7 +35,7 @@ SRC
   touch "$B/tbb/.built-$TBB_VERSION"
 fi
 cmake -S "$ROOT" -B "$B" -G Ninja -DCMAKE_CXX_COMPILER=clang++ -DCMAKE_BUILD_TYPE=RelWithDebInfo \
-  -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -g -DNDEBUG" -DNEEPP_PGO= -DNEEPP_MARCH=x86-64-v3 -DNEEPP_SANITIZE=thread \
+  -DNEEPP_PGO= -DNEEPP_MARCH=x86-64-v3 -DNEEPP_SANITIZE=thread \
   -DCMAKE_PREFIX_PATH="$B/tbb" >/dev/null
 cmake --build "$B" --target test_render test_visibility -j"$(nproc)"
 export TSAN_OPTIONS="halt_on_error=1 second_deadlock_stack=1 suppressions=$ROOT/tests/sanitizers/tsan.supp"
