@@ -1,12 +1,12 @@
 #include "neepp/integrators/neepp_auto.h"
 
-#include <time.h>
 #include <atomic>
 #include <chrono>
 #include <optional>
 #include <fmt/format.h>
 #include <tbb/parallel_for.h>
 #include "neepp/integrators/path.h"
+#include "neepp/render/stats.h"
 #include "neepp/sampling/sampler.h"
 #include "neepp/visibility/neepp_shadow_rays.h"
 #include "neepp/scene/scene.h"
@@ -21,12 +21,6 @@ bool several_lights(const Scene &scene) { return scene.lights().size() > 1; }
 NeeppShadowRays *map_keeper(Integrator &integrator) {
     auto *path = dynamic_cast<PathIntegrator *>(&integrator);
     return path ? dynamic_cast<NeeppShadowRays *>(&path->shadow_rays()) : nullptr;
-}
-
-double thread_cpu_seconds() {
-    timespec t{};
-    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
-    return double(t.tv_sec) + 1e-9 * double(t.tv_nsec);
 }
 
 // The pilot: kPilotSpp samples of each pixel of a grid over the film, through Li_batch as the render
@@ -46,7 +40,7 @@ PilotFigures run_pilot(const Scene &scene, const Integrator &integrator, int fir
     std::atomic<int64_t> cpu_ns{0};
     const IndependentSampler prototype(0x9117ull);
     tbb::parallel_for(0, gy, [&](int j) {
-        const double t0 = thread_cpu_seconds();
+        const double t0 = cpu_seconds(CpuClock::thread);
         RenderCounters counters;  // the pilot's rays are not the render's
         std::vector<std::unique_ptr<Sampler>> owned;
         std::vector<Sampler *> samplers;
@@ -75,7 +69,7 @@ PilotFigures run_pilot(const Scene &scene, const Integrator &integrator, int fir
             mean[p] = m;
             var[p] = std::max(0.0, (m2 - K * m * m) / (K - 1));
         }
-        cpu_ns += int64_t((thread_cpu_seconds() - t0) * 1e9);
+        cpu_ns += int64_t((cpu_seconds(CpuClock::thread) - t0) * 1e9);
     });
     double sum_mean = 0, sum_var = 0;
     for (size_t p = 0; p < mean.size(); ++p) sum_mean += mean[p], sum_var += var[p];

@@ -2,7 +2,6 @@
 
 #include <chrono>
 #include <cmath>
-#include <ctime>
 #include <memory>
 #include <mutex>
 #include <tbb/enumerable_thread_specific.h>
@@ -14,6 +13,7 @@
 #include "neepp/render/film.h"
 #include "neepp/render/memory.h"
 #include "neepp/render/progress_bar.h"
+#include "neepp/render/stats.h"
 #include "neepp/sampling/sampler.h"
 #include "neepp/scene/scene.h"
 
@@ -21,12 +21,6 @@ namespace neepp {
 namespace {
 
 using Clock = std::chrono::steady_clock;
-
-double process_cpu_time_s() {
-    timespec t{};
-    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
-    return double(t.tv_sec) + 1e-9 * double(t.tv_nsec);
-}
 
 // Camera samples handed to the integrator at once (Integrator::Li_batch).
 constexpr int kBatch = 32;
@@ -126,7 +120,7 @@ RenderResult render(const Scene &scene, Integrator &integrator, const RenderJob 
     RenderResult result;
     tbb::enumerable_thread_specific<RenderCounters> counters;
     const Clock::time_point start = Clock::now();
-    const double cpu_start = process_cpu_time_s();
+    const double cpu_start = cpu_seconds(CpuClock::process);
     const double time_before = job.resume ? job.resume->render_time_s : 0.0;  // a resumed render's earlier time
     auto elapsed = [&] { return time_before + std::chrono::duration<double>(Clock::now() - start).count(); };
 
@@ -329,7 +323,7 @@ RenderResult render(const Scene &scene, Integrator &integrator, const RenderJob 
     bar.finish();
 
     result.render_time_s = elapsed();
-    result.render_cpu_time_s = process_cpu_time_s() - cpu_start;
+    result.render_cpu_time_s = cpu_seconds(CpuClock::process) - cpu_start;
     result.counters = counted();
     result.occlusion_time_s = double(result.counters.occlusion_ticks) * seconds_per_tick();
     result.image = current_image();

@@ -24,6 +24,11 @@ struct RenderCounters {
     }
 };
 
+// CPU time in seconds of this process (all its threads) or of the calling thread alone: what the render
+// loop reports as render_cpu_time_s and what neepp=auto's pilot charges each candidate.
+enum class CpuClock { process, thread };
+double cpu_seconds(CpuClock clock);
+
 // Seconds per tick of the CPU timestamp counter, calibrated once against the steady clock.
 double seconds_per_tick();
 uint64_t read_ticks();
