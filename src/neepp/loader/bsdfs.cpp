@@ -210,7 +210,7 @@ BSDFPtr Factories::create_bsdf(const XmlNode &node) {
     } else if (t == "polarizer") {
         // The polarizer's angle changes nothing for unpolarized light: read only so that it is not "unused".
         texture_param(node, "theta", Color(0.f), true);
-        b = std::make_shared<PolarizerBSDF>(texture_param(node, "transmittance", Color(1.f)));
+        b = std::make_shared<NullBSDF>(texture_param(node, "transmittance", Color(1.f)), 0.5f);
     } else if (t == "mask") {
         auto kids = nested(1, 1);
         b = std::make_shared<MaskBSDF>(texture_param(node, "opacity", Color(0.5f)), bsdf(*kids[0]));

@@ -30,6 +30,11 @@ public:
     float eval(const Vec3 &m) const;
     // Density of sample(wi, .) producing m: D_wi(m) if visible normals are sampled, else D(m) cos(theta_m).
     float pdf(const Vec3 &wi, const Vec3 &m) const;
+    // Density of the direction wo = reflect(wi, h) when h is drawn by sample(wi, .), given D(h) and G1(wi, h)
+    // already computed for the BSDF's value (both plastics' specular lobes).
+    float reflection_pdf(const Vec3 &wi, const Vec3 &wo, const Vec3 &h, float d, float g1_i) const {
+        return sample_visible_ ? d * g1_i / (4.f * wi.z) : pdf(wi, h) / (4.f * dot(wo, h));
+    }
     // Samples a microfacet normal; returns it with its density pdf(wi, m).
     std::pair<Vec3, float> sample(const Vec3 &wi, Vec2 u) const;
     // The same normal without its density, for callers that evaluate a mixture's density themselves

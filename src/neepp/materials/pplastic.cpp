@@ -31,8 +31,7 @@ BSDFEval PolarizedPlasticBSDF::eval_pdf(const BSDFContext &, const SurfaceIntera
     const float t_i = 1.f - fresnel_dielectric(wi.z, eta_).r, t_o = 1.f - fresnel_dielectric(wo.z, eta_).r;
     r.f += diffuse_reflectance_->eval(si) * (t_i * t_o * kInvPi * wo.z);
 
-    float spec = distr.sample_visible() ? d * g1_i / (4.f * wi.z) : distr.pdf(wi, h) / (4.f * dot(wo, h));
-    if (dot(wi, h) <= 0.f || dot(wo, h) <= 0.f) spec = 0.f;
+    const float spec = dot(wi, h) > 0.f && dot(wo, h) > 0.f ? distr.reflection_pdf(wi, wo, h, d, g1_i) : 0.f;
     r.pdf = specular_sampling_weight_ * spec + (1.f - specular_sampling_weight_) * square_to_cosine_hemisphere_pdf(wo);
     return r;
 }

@@ -103,7 +103,7 @@ BSDFEval RoughPlasticBSDF::eval_pdf(const BSDFContext &, const SurfaceInteractio
 
     // The lobes' mixture density (the specular lobe's probability from the same transmittance t_i).
     float p_spec = prob_specular(t_i);
-    float spec = distr_.sample_visible() ? d * g1_i / (4.f * wi.z) : distr_.pdf(wi, h) / (4.f * dot(wo, h));
+    const float spec = distr_.reflection_pdf(wi, wo, h, d, g1_i);
     r.pdf = p_spec * spec + (1.f - p_spec) * square_to_cosine_hemisphere_pdf(wo);
     return r;
 }

@@ -45,14 +45,8 @@ BSDFEval MaskBSDF::eval_pdf(const BSDFContext &ctx, const SurfaceInteraction &si
 BSDFSample MaskBSDF::sample(const BSDFContext &ctx, const SurfaceInteraction &si, const Vec3 &wi, float u1,
                             Vec2 u2) const {
     float a = opacity(si);
-    if (u1 >= a) {  // pass through: a null event chosen with probability 1 - a, weight (1-a)/(1-a)
-        BSDFSample bs;
-        bs.wo = -wi;
-        bs.pdf = 1.f - a;
-        bs.sampled_flags = BSDFNull;
-        bs.weight = Color(1.f);
-        return bs;
-    }
+    // Pass through: a null event chosen with probability 1 - a, weight (1-a)/(1-a).
+    if (u1 >= a) return NullBSDF::pass_through(wi, 1.f - a, Color(1.f));
     BSDFSample bs = nested_->sample(ctx, si, wi, u1 / a, u2);
     bs.pdf *= a;  // f is scaled by a too, so the weight f/pdf is unchanged
     return bs;
