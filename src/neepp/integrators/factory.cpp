@@ -94,6 +94,10 @@ std::unique_ptr<Integrator> make_path(const Options &options) {
     o.light_sampler = options.get_string("light_sampler", o.light_sampler);
     check_light_sampler_name(o.light_sampler);
     o.within_light = options.get_string("within_light", o.within_light);
+    const std::string form = options.get_string("form", "fast");
+    if (form != "fast" && form != "reference")
+        throw std::invalid_argument("form must be 'fast' or 'reference', not '" + form + "'");
+    o.reference = form == "reference";
     const auto &within = WithinLightSampling::names();
     if (std::find(within.begin(), within.end(), o.within_light) == within.end())
         throw std::invalid_argument("within_light must be 'own' or 'visibility', not '" + o.within_light + "'");

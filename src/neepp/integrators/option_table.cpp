@@ -55,6 +55,9 @@ std::vector<IntegratorDoc> make_docs() {
                             "off: the options below as given; auto: with several lights, a pilot measures plain NEE, "
                             "light_sampler=spatial-oriented and light_sampler=visibility, and renders with the most "
                             "efficient (docs/neepp.md)", ""});
+    path.options.push_back({"form", "fast",
+                            "fast (paths in batches, the default) or reference (one path at a time, the estimator's "
+                            "definition: the same image in expectation, slower)", ""});
     path.options.push_back({"nee", text(p.nee), "next event estimation (false: BSDF sampling only, the paper's Path)", ""});
     path.options.push_back({"light_sampler", p.light_sampler, "which light NEE samples: " + samplers, ""});
     path.options.push_back({"within_light", p.within_light,

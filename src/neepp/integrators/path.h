@@ -12,8 +12,6 @@
 
 namespace neepp {
 
-class LightSampleLanes;
-
 struct PathOptions {
     int max_depth = -1;
     int rr_depth = 5;
@@ -31,6 +29,9 @@ struct PathOptions {
     int ris = 1;
     float ris_floor = 0.05f;  // as q_min: a wrong map costs at most a factor 1/ris_floor in a sample's weight
     int ris_depth = 1;
+    // Which form renders: fast (PathBatch, the default) or reference (PathIntegrator::Li, one path at a
+    // time: the definition, slower).
+    bool reference = false;
 };
 
 class PathIntegrator final : public Integrator {
@@ -47,11 +48,12 @@ public:
     }
     void restore_state(const Scene &scene, const std::string &state) override;
     nlohmann::json statistics() const override;
+    // The reference form: one path, one vertex at a time, every choice made where it reads (path.cpp).
+    // It defines what the path tracer computes; the fast form below is tested against it.
     Color Li(const Scene &scene, const Ray &ray, Sampler &sampler, RenderCounters &counters) const override;
-    // Paths of a batch advance in lockstep, one bounce at a time and stage by stage, each stage issuing
-    // cache prefetches that the next stage, reached after the other paths' work, finds complete: without
-    // it the render waits on misses (mesh data, textures, environment-map tables) as long as it traces.
-    // Same random numbers in the same order per path as Li, so the same result to the bit.
+    // The fast form (PathBatch, path_batch.cpp): the batch's paths advance in lockstep, stage by stage, so
+    // that cache prefetches and packets of rays pay. Same random numbers in the same order per path as Li.
+    // With form=reference it renders through Li instead.
     void Li_batch(const Scene &scene, std::span<const Ray> rays, std::span<Sampler *const> samplers,
                   std::span<Color> out, RenderCounters &counters) const override;
     nlohmann::json describe() const override;
@@ -60,31 +62,27 @@ public:
     ShadowRayTester &shadow_rays() { return *shadow_; }
 
 private:
-    struct Candidate;  // one light sample of next event estimation
-    struct Path;  // one path's state between stages
-    // Stages of one bounce (see Li_batch). begin_vertex and finish_vertex return false when the path ends.
-    bool begin_vertex(const Scene &scene, Path &path) const;
-    // Next event estimation at the vertex: begin_light and sample_light sample the light chosen at
-    // begin_vertex in two steps (Light::begin_sample, finish_sample), the second eight at a time where the
-    // light allows it (LightSampleLanes: a rectangle of constant radiance); with resampling (ris > 1) that is
-    // done for each candidate, weigh_candidates evaluates the BSDF toward each and prefetches its map
-    // entry, and resample reads the entries and chooses one; begin_direct forms
-    // the shadow query, its contribution MIS-weighted against BSDF sampling and multiplied by the path
-    // throughput so contribution-aware policies see all of it (false: it contributes nothing); decide_direct asks the shadow-ray policy
-    // and returns true when a ray must be traced, whose outcome end_direct takes.
-    void begin_light(Path &path) const;
-    void sample_light(Path &path, LightSampleLanes &lanes) const;
-    void weigh_candidates(Path &path) const;
-    void resample(Path &path) const;
-    bool begin_direct(Path &path) const;
-    bool decide_direct(Path &path, RenderCounters &counters) const;
-    void end_direct(Path &path, bool occluded) const;
-    // BSDF sampling and Russian roulette: the next ray, or false when the path ends.
-    bool finish_vertex(Path &path) const;
-
+    friend class PathBatch;
+    struct LightCandidate;
+    // The light-selection context of a scattering vertex reached along direction d: its normal turned
+    // toward the side the path arrived from (the side it gathers light on), so that orientation-aware
+    // samplers see which way it faces. Made once per vertex and used both where lights are sampled and
+    // where MIS asks for the pmf, so the two agree.
+    static LightSampleContext light_context(const SurfaceInteraction &si, const Vec3 &d) {
+        return {si.p, dot(d, si.n) > 0 ? -si.n : si.n};
+    }
+    // Next event estimation at a scattering vertex (pbrt-v4's SampleLd): a light sample, or with ris > 1
+    // one of M resampled ones, tested by the shadow-ray component; the contribution already multiplied by
+    // the path throughput beta, which contribution-aware shadow-ray policies need to see.
+    Color sample_direct(const Scene &scene, const SurfaceInteraction &si, const LightSampleContext &ctx,
+                        const Color &beta, int M, Sampler &sampler, RenderCounters &counters) const;
     // MIS weight for emission found by a BSDF-sampled ray leaving prev (pdf prev_pdf) toward light.
     float emission_weight(const Light &light, const LightSampleContext &prev, const DirectionSample &ds,
                           float prev_pdf) const;
+    // Light-sample candidates at a vertex of this depth: options_.ris at the first ris_depth, else 1.
+    int candidates_at(int depth) const {
+        return options_.ris_depth < 0 || depth < options_.ris_depth ? options_.ris : 1;
+    }
     bool resampling() const { return options_.ris > 1; }
     // The map's share of the resampling target, from the map the coming pass reads.
     void refresh_resampling();

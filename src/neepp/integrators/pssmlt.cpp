@@ -71,8 +71,13 @@ float PSSMLTIntegrator::evaluate(const Scene &scene, PrimarySampleSpaceSampler &
     const Vec2 lens = cam.has_lens() ? sampler.next_2d() : Vec2(0.5f, 0.5f);
     const Ray ray = cam.generate_ray(u, lens);
     ContributionList splats(out);
-    const Color L = inner_->splats() ? inner_->Li_splat(scene, ray, sampler, counters, splats)
-                                     : inner_->Li(scene, ray, sampler, counters);
+    Color L;
+    if (inner_->splats()) {
+        L = inner_->Li_splat(scene, ray, sampler, counters, splats);
+    } else {  // the inner integrator's own form (path: the fast one, a batch of one path, unless form=reference)
+        Sampler *const samplers[1] = {&sampler};
+        inner_->Li_batch(scene, std::span<const Ray>(&ray, 1), samplers, std::span<Color>(&L, 1), counters);
+    }
     if (is_finite(L)) out.push_back({Vec2(u.x * float(cam.width), u.y * float(cam.height)), L});
     else ++counters.invalid_samples;
     float f = 0;
