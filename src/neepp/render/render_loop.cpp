@@ -43,7 +43,7 @@ std::vector<Tile> make_tiles(int width, int height, int size) {
 // each packet of 16 rays the path tracer traces then starts from one pixel, and coherent rays are cheaper
 // to trace. Under a time limit a pass is sized to end before the deadline by the speed of the last
 // (with a 5% margin): a pass is all or nothing, so one cut off by the deadline would be work thrown away.
-int next_pass_size(int done, int target, double seconds_per_spp, double remaining_s, bool timed, bool learns) {
+int pass_size(int done, int target, double seconds_per_spp, double remaining_s, bool timed, bool learns) {
     constexpr int kMaxPass = 32;
     int size = done == 0 ? 1 : learns ? std::min(done, kMaxPass) : kMaxPass;
     if (target > 0) size = std::min(size, target - done);
@@ -86,249 +86,317 @@ Image combine_layers(const ImageBlock &samples, const SplatFilm *splats, double 
     return image;
 }
 
+// How long the render may go on: its sample count or time limit, the time a resumed render had spent
+// before, and the size of each pass.
+class RenderBudget {
+public:
+    explicit RenderBudget(const RenderJob &job)
+        : job_(job), start_(Clock::now()), time_before_(job.resume ? job.resume->render_time_s : 0.0) {}
+    bool timed() const { return job_.time_limit_s > 0; }
+    // Seconds of rendering, a resumed render's earlier ones included.
+    double elapsed() const { return time_before_ + std::chrono::duration<double>(Clock::now() - start_).count(); }
+    double remaining() const { return timed() ? job_.time_limit_s - elapsed() : 0; }
+    bool spp_reached(int spp) const { return job_.spp > 0 && spp >= job_.spp; }
+    int next_pass_size(int done, double seconds_per_spp, bool learns) const {
+        return pass_size(done, job_.spp, seconds_per_spp, remaining(), timed(), learns);
+    }
+    // A time limit cuts a pass short only when it overruns badly (the first pass, whose speed was unknown,
+    // or a wrong estimate): otherwise the pass, sized to fit, is finished.
+    bool overrun(int passes_done) const {
+        return timed() && (passes_done == 0 ? elapsed() > job_.time_limit_s : elapsed() > 1.25 * job_.time_limit_s);
+    }
+    // The fraction done, for the progress bar: of the sample range, or of the time.
+    double fraction(double spp_done) const {
+        if (timed() && job_.spp <= 0) return elapsed() / job_.time_limit_s;
+        const int first = job_.resume ? 0 : job_.first_sample;
+        const double f = (spp_done - first) / double(job_.spp - first);
+        return timed() ? std::max(f, elapsed() / job_.time_limit_s) : f;
+    }
+
+private:
+    const RenderJob &job_;
+    const Clock::time_point start_;
+    const double time_before_;
+};
+
+// One call of render(): the image so far, its passes, and what the render loop reports and saves.
+class RenderLoop {
+public:
+    // Before any memory is taken: a job that says how long to render, and a film that fits.
+    static void check_job(const Scene &scene, const Integrator &integrator, const RenderJob &job) {
+        if (job.spp <= 0 && !(job.time_limit_s > 0)) throw std::invalid_argument("render: give a sample count or a time limit");
+        // Per pixel: the image and the pass (ImageBlock, 32 bytes each), the image resolved for the pass
+        // statistics and for the result (12 each), the PNG's bytes (4); with splats, two splat films (24
+        // bytes each) and the splat layer resolved (12).
+        check_film_fits_in_memory(scene.camera.width, scene.camera.height,
+                                  2 * 32 + 2 * 12 + 4 + (integrator.splats() ? 2 * 24 + 12 : 0));
+    }
+
+    RenderLoop(const Scene &scene, Integrator &integrator, const RenderJob &job);
+    RenderResult run();
+
+private:
+    bool cancelled() const { return job_.cancel && job_.cancel->load(); }
+    // One pass of `size` samples per pixel into pass_block_ (and splats_pass_); false when it was cut short.
+    bool render_pass(int size);
+    // The tile loop's share of a pass: each tile's samples, in batches, into the tile's block.
+    void render_tile(size_t index, int s0, int size, std::vector<Sampler *> &samplers, RenderCounters &c);
+    void merge_pass(uint64_t pass_light_paths);
+    // Light paths the pass's camera samples splatted (an integrator's own pass body counts its own).
+    double camera_sample_light_paths() const {
+        return integrator_.renders_passes() ? 0.0 : integrator_.light_paths_per_sample() * double(samples_done_);
+    }
+    Image current_image() const {
+        return combine_layers(accumulated_, splats_accumulated_.get(), light_paths_, integrator_.splat_scale());
+    }
+    RenderCounters counted() const {
+        RenderCounters sum = counters_before_;
+        for (const RenderCounters &t : counters_) sum += t;
+        return sum;
+    }
+    RenderCheckpoint make_checkpoint(const RenderCounters &counted_so_far) const;
+    void checkpoint(const RenderCounters &counted_so_far) {
+        job_.on_checkpoint(make_checkpoint(counted_so_far), current_image());
+        last_checkpoint_ = budget_.elapsed();
+    }
+
+    const Scene &scene_;
+    Integrator &integrator_;
+    const RenderJob &job_;
+    const Camera &cam_;
+    const int W_, H_;
+    const bool splatting_;
+    ReconstructionFilter filter_;
+    int border_ = 0;  // how far a sample's filter reaches beyond its pixel
+    // The image (samples, and the splat layer of integrators whose samples add to other pixels, scaled by
+    // pixels / light paths), and the pass being rendered.
+    ImageBlock accumulated_, pass_block_;
+    std::unique_ptr<SplatFilm> splats_accumulated_, splats_pass_;
+    double light_paths_ = 0;
+    std::mutex merge_mutex_;
+    std::vector<Tile> tiles_;
+    std::vector<double> tile_m2_;  // Σ lum(L)² per tile this pass, summed in tile order
+    const std::unique_ptr<Sampler> prototype_;
+    const int threads_;
+    tbb::global_control limit_;
+    tbb::task_arena arena_;
+    tbb::enumerable_thread_specific<RenderCounters> counters_;
+    RenderCounters counters_before_;        // a resumed render's
+    RenderCounters counted_at_pass_start_;  // what a checkpoint of a pass cut short holds
+    RenderBudget budget_;
+    const double cpu_start_;
+    std::atomic<uint64_t> samples_done_{0};  // camera samples completed this pass
+    std::atomic<int> spp_done_now_{0};
+    std::atomic<bool> aborted_{false};
+    double one_off_s_ = 0;  // seconds of the pass spent on one-off work (PSSMLT's bootstrap)
+    double seconds_per_spp_ = 0;
+    double last_checkpoint_ = 0, last_snapshot_ = 0;
+    RenderResult result_;
+};
+
+RenderLoop::RenderLoop(const Scene &scene, Integrator &integrator, const RenderJob &job)
+    : scene_(scene), integrator_(integrator), job_(job), cam_(scene.camera), W_(cam_.width), H_(cam_.height),
+      splatting_(integrator.splats()),
+      filter_(scene.settings.rfilter, scene.settings.rfilter_radius, scene.settings.rfilter_stddev),
+      accumulated_((check_job(scene, integrator, job), 0), 0, W_, H_, &filter_), pass_block_(0, 0, W_, H_, &filter_),
+      tiles_(make_tiles(W_, H_, job.tile_size)), tile_m2_(tiles_.size()),
+      prototype_(make_sampler(job.sampler, job.seed)),
+      threads_(job.threads > 0 ? job.threads : tbb::info::default_concurrency()),
+      limit_(tbb::global_control::max_allowed_parallelism, size_t(threads_)), arena_(threads_), budget_(job),
+      cpu_start_(cpu_seconds(CpuClock::process)) {
+    border_ = int(std::ceil(filter_.radius() - 0.5f));
+    if (splatting_) {
+        splats_accumulated_ = std::make_unique<SplatFilm>(W_, H_, &filter_);
+        splats_pass_ = std::make_unique<SplatFilm>(W_, H_, &filter_);
+    }
+}
+
+RenderResult RenderLoop::run() {
+    ProgressBar bar([this] { return budget_.fraction(spp_done_now_.load() + double(samples_done_.load()) / (double(W_) * H_)); },
+                    job_.progress, job_.on_progress);
+    integrator_.prepare(scene_);
+    if (job_.resume) {  // continue the render a checkpoint holds
+        const RenderCheckpoint &c = *job_.resume;
+        if (splatting_ != !c.splat_sums.empty()) throw std::invalid_argument("resume: the checkpoint's splats do not match the integrator");
+        accumulated_.set_sums(c.image_sums);
+        if (splatting_) splats_accumulated_->set_sums(c.splat_sums);
+        light_paths_ = c.light_paths;
+        result_.spp = result_.resumed_spp = c.spp;
+        result_.passes = c.passes;
+        seconds_per_spp_ = c.seconds_per_spp;
+        counters_before_ = c.counters;
+        spp_done_now_ = result_.spp;
+        integrator_.restore_state(scene_, c.integrator_state);
+    }
+    if (!job_.resume && job_.first_sample > 0) {  // a range of sample indices (distributed rendering)
+        if (job_.spp <= job_.first_sample) throw std::invalid_argument("render: the sample range is empty");
+        result_.spp = job_.first_sample;
+        spp_done_now_ = result_.spp;
+    }
+    if (!job_.resume && job_.integrator_state) integrator_.restore_state(scene_, *job_.integrator_state);
+
+    last_checkpoint_ = budget_.elapsed();
+    bool checkpointed_at_stop = false;
+    for (;;) {
+        if (cancelled()) { result_.stopped_by = "cancel"; break; }
+        if (budget_.timed() && budget_.remaining() <= 0) { result_.stopped_by = "time"; break; }
+        const int size = budget_.next_pass_size(result_.spp, seconds_per_spp_, integrator_.learns_between_passes());
+        if (size <= 0) { result_.stopped_by = budget_.spp_reached(result_.spp) ? "spp" : "time"; break; }
+
+        const double pass_start = budget_.elapsed();
+        if (!render_pass(size)) {
+            // A checkpoint holds whole passes: the one cut short is not in it (nor in a resumed image).
+            if (job_.on_checkpoint && result_.passes > 0) checkpoint(counted_at_pass_start_);
+            checkpointed_at_stop = true;
+            result_.stopped_by = cancelled() ? "cancel" : "time";
+            break;
+        }
+        result_.spp += size;
+        spp_done_now_ = result_.spp;
+        integrator_.end_pass(scene_, pass_statistics(result_.passes, result_.spp, size, tile_m2_, accumulated_));
+        ++result_.passes;
+        seconds_per_spp_ = std::max(budget_.elapsed() - pass_start - one_off_s_, 0.0) / size;
+        if (job_.on_snapshot && (last_snapshot_ == 0 || budget_.elapsed() >= job_.snapshot_growth * last_snapshot_)) {
+            last_snapshot_ = budget_.elapsed();
+            job_.on_snapshot(result_.spp, last_snapshot_, current_image());
+        }
+        if (budget_.spp_reached(result_.spp)) { result_.stopped_by = "spp"; break; }
+        if (job_.on_checkpoint && budget_.elapsed() - last_checkpoint_ >= job_.checkpoint_interval_s) checkpoint(counted());
+    }
+    // Stopped before its sample count between passes (time, Ctrl-C): what a resume continues from.
+    if (job_.on_checkpoint && result_.stopped_by != "spp" && !checkpointed_at_stop && result_.passes > 0) checkpoint(counted());
+    bar.finish();
+
+    result_.render_time_s = budget_.elapsed();
+    result_.render_cpu_time_s = cpu_seconds(CpuClock::process) - cpu_start_;
+    result_.counters = counted();
+    result_.occlusion_time_s = double(result_.counters.occlusion_ticks) * seconds_per_tick();
+    result_.image = current_image();
+    if (job_.keep_state) result_.state = make_checkpoint(result_.counters);
+    return std::move(result_);
+}
+
+bool RenderLoop::render_pass(int size) {
+    const int s0 = result_.spp;
+    if (job_.on_checkpoint) counted_at_pass_start_ = counted();
+    pass_block_.clear();
+    samples_done_ = 0;
+    aborted_ = false;
+    one_off_s_ = 0;
+    // Cancellation (Ctrl-C, SIGTERM) and a bad overrun of the time limit end the pass where it is.
+    auto must_stop = [this] {
+        if (cancelled() || budget_.overrun(result_.passes)) aborted_ = true;
+        return aborted_.load(std::memory_order_relaxed);
+    };
+    // Light paths splatted apart from the camera samples (BDPT's NEE++ pool before the pass) or the
+    // samples of an integrator's own pass body.
+    uint64_t pass_light_paths = 0;
+    const PassInfo info{result_.passes, s0, size, uint64_t(W_) * H_ * size, job_.seed};
+    if (splatting_) {
+        splats_pass_->clear();
+        if (!integrator_.renders_passes())
+            arena_.execute([&] { pass_light_paths = integrator_.begin_pass(scene_, info, *splats_pass_, counters_.local()); });
+    }
+    if (integrator_.renders_passes()) {
+        const PassControl control{must_stop, &samples_done_, &one_off_s_};
+        arena_.execute([&] { pass_light_paths = integrator_.render_pass(scene_, info, *splats_pass_, counters_.local(), control); });
+    } else arena_.execute([&] {
+        tbb::parallel_for(tbb::blocked_range<size_t>(0, tiles_.size(), 1), [&](const tbb::blocked_range<size_t> &r) {
+            const DenormalsAreZero ftz;
+            // Samples go to the integrator in batches (see Integrator::Li_batch), each with its own sampler.
+            std::vector<std::unique_ptr<Sampler>> owned;
+            std::vector<Sampler *> samplers;
+            for (int k = 0; k < kBatch; ++k) samplers.push_back(owned.emplace_back(prototype_->clone()).get());
+            RenderCounters &c = counters_.local();
+            for (size_t ti = r.begin(); ti != r.end(); ++ti) {
+                if (aborted_.load(std::memory_order_relaxed) || must_stop()) return;
+                render_tile(ti, s0, size, samplers, c);
+            }
+        });
+    });
+    if (aborted_) {
+        // Keep a partial first pass rather than nothing at all: every pixel it reached is unbiased.
+        if (result_.passes == 0) merge_pass(pass_light_paths);
+        return false;
+    }
+    merge_pass(pass_light_paths);
+    return true;
+}
+
+void RenderLoop::render_tile(size_t index, int s0, int size, std::vector<Sampler *> &samplers, RenderCounters &c) {
+    const Tile &t = tiles_[index];
+    std::vector<Ray> rays(kBatch);
+    std::vector<Vec2> film_pos(kBatch);
+    std::vector<Color> radiance(kBatch);
+    double m2 = 0;
+    ImageBlock block(t.x0 - border_, t.y0 - border_, t.w + 2 * border_, t.h + 2 * border_, &filter_);
+    int queued = 0;
+    auto add = [&](const Vec2 &pos, Color L) {
+        // Only NaN/inf are dropped: negative values are legitimate for unbiased estimators such as NEE++'s
+        // control variate and must average out.
+        if (!is_finite(L)) {
+            ++c.invalid_samples;
+            L = Color(0.f);
+        }
+        block.put(pos.x, pos.y, L);
+        m2 += double(luminance(L)) * double(luminance(L));
+    };
+    auto flush = [&] {
+        integrator_.Li_batch(scene_, std::span<const Ray>(rays.data(), queued),
+                             std::span<Sampler *const>(samplers.data(), queued), std::span<Color>(radiance.data(), queued), c);
+        for (int k = 0; k < queued; ++k) add(film_pos[k], radiance[k]);
+        queued = 0;
+    };
+    for (int y = t.y0; y < t.y0 + t.h; ++y)
+        for (int x = t.x0; x < t.x0 + t.w; ++x)
+            for (int s = s0; s < s0 + size; ++s) {
+                Sampler &sampler = *samplers[queued];
+                // Film pixels, so that a crop's pixels draw what the whole film's do.
+                sampler.start_sample(uint32_t(x + cam_.crop_x), uint32_t(y + cam_.crop_y), uint32_t(s));
+                Vec2 jitter = sampler.next_2d();
+                film_pos[queued] = Vec2(float(x) + jitter.x, float(y) + jitter.y);
+                // As Mitsuba: a lens's sample follows the film position's.
+                const Vec2 lens = cam_.has_lens() ? sampler.next_2d() : Vec2(0.5f, 0.5f);
+                rays[queued] = cam_.pixel_ray(x, y, jitter, lens);
+                if (splatting_) {
+                    add(film_pos[queued], integrator_.Li_splat(scene_, rays[queued], sampler, c, *splats_pass_));
+                    continue;
+                }
+                if (++queued == kBatch) flush();
+            }
+    if (queued > 0) flush();
+    tile_m2_[index] = m2;
+    samples_done_ += uint64_t(t.w) * t.h * size;
+    std::lock_guard<std::mutex> lock(merge_mutex_);
+    pass_block_.merge(block);
+}
+
+void RenderLoop::merge_pass(uint64_t pass_light_paths) {
+    accumulated_.merge(pass_block_);
+    if (splatting_) {
+        splats_accumulated_->merge(*splats_pass_);
+        light_paths_ += double(pass_light_paths) + camera_sample_light_paths();
+    }
+}
+
+RenderCheckpoint RenderLoop::make_checkpoint(const RenderCounters &counted_so_far) const {
+    RenderCheckpoint c;
+    c.spp = result_.spp;
+    c.passes = result_.passes;
+    c.render_time_s = budget_.elapsed();
+    c.seconds_per_spp = seconds_per_spp_;
+    c.light_paths = light_paths_;
+    c.counters = counted_so_far;
+    c.image_sums = accumulated_.sums();
+    if (splatting_) c.splat_sums = splats_accumulated_->sums();
+    c.integrator_state = integrator_.save_state();
+    return c;
+}
+
 }  // namespace
 
 RenderResult render(const Scene &scene, Integrator &integrator, const RenderJob &job) {
-    const Camera &cam = scene.camera;
-    const int W = cam.width, H = cam.height;
-    const bool timed = job.time_limit_s > 0;
-    if (job.spp <= 0 && !timed) throw std::invalid_argument("render: give a sample count or a time limit");
-
-    // Per pixel: the image and the pass (ImageBlock, 32 bytes each), the image resolved for the pass
-    // statistics and for the result (12 each), the PNG's bytes (4); with splats, two splat films (24
-    // bytes each) and the splat layer resolved (12).
-    const bool splatting = integrator.splats();
-    check_film_fits_in_memory(W, H, 2 * 32 + 2 * 12 + 4 + (splatting ? 2 * 24 + 12 : 0));
-    ReconstructionFilter filter(scene.settings.rfilter, scene.settings.rfilter_radius, scene.settings.rfilter_stddev);
-    const int border = int(std::ceil(filter.radius() - 0.5f));
-    ImageBlock accumulated(0, 0, W, H, &filter), pass_block(0, 0, W, H, &filter);
-    // Light tracing and BDPT splat anywhere on the film: a layer of its own, scaled by pixels / light paths.
-    std::unique_ptr<SplatFilm> splats_accumulated, splats_pass;
-    if (splatting) {
-        splats_accumulated = std::make_unique<SplatFilm>(W, H, &filter);
-        splats_pass = std::make_unique<SplatFilm>(W, H, &filter);
-    }
-    double light_paths = 0;
-    std::mutex merge_mutex;
-    std::vector<Tile> tiles = make_tiles(W, H, job.tile_size);
-    const std::unique_ptr<Sampler> prototype = make_sampler(job.sampler, job.seed);
-
-    int threads = job.threads > 0 ? job.threads : tbb::info::default_concurrency();
-    tbb::global_control limit(tbb::global_control::max_allowed_parallelism, size_t(threads));
-    tbb::task_arena arena(threads);
-
-    RenderResult result;
-    tbb::enumerable_thread_specific<RenderCounters> counters;
-    const Clock::time_point start = Clock::now();
-    const double cpu_start = cpu_seconds(CpuClock::process);
-    const double time_before = job.resume ? job.resume->render_time_s : 0.0;  // a resumed render's earlier time
-    auto elapsed = [&] { return time_before + std::chrono::duration<double>(Clock::now() - start).count(); };
-
-    std::vector<double> tile_m2(tiles.size());  // Σ lum(L)² per tile this pass, summed in tile order
-    std::atomic<uint64_t> samples_done{0};  // camera samples completed this pass
-    std::atomic<int> pass_size_now{0}, spp_done_now{0};
-    auto fraction = [&]() -> double {
-        if (timed && job.spp <= 0) return elapsed() / job.time_limit_s;
-        double spp_done = spp_done_now.load() + double(samples_done.load()) / (double(W) * H);
-        const int first = job.resume ? 0 : job.first_sample;
-        double f = (spp_done - first) / double(job.spp - first);
-        return timed ? std::max(f, elapsed() / job.time_limit_s) : f;
-    };
-    ProgressBar bar(fraction, job.progress, job.on_progress);
-
-    integrator.prepare(scene);
-    double seconds_per_spp = 0;
-    RenderCounters counters_before;  // a resumed render's
-    if (job.resume) {
-        const RenderCheckpoint &c = *job.resume;
-        if (splatting != !c.splat_sums.empty()) throw std::invalid_argument("resume: the checkpoint's splats do not match the integrator");
-        accumulated.set_sums(c.image_sums);
-        if (splatting) splats_accumulated->set_sums(c.splat_sums);
-        light_paths = c.light_paths;
-        result.spp = result.resumed_spp = c.spp;
-        result.passes = c.passes;
-        seconds_per_spp = c.seconds_per_spp;
-        counters_before = c.counters;
-        spp_done_now = result.spp;
-        integrator.restore_state(scene, c.integrator_state);
-    }
-    if (!job.resume && job.first_sample > 0) {  // a range of sample indices (distributed rendering)
-        if (job.spp <= job.first_sample) throw std::invalid_argument("render: the sample range is empty");
-        result.spp = job.first_sample;
-        spp_done_now = result.spp;
-    }
-    if (!job.resume && job.integrator_state) integrator.restore_state(scene, *job.integrator_state);
-    auto current_image = [&] {
-        return combine_layers(accumulated, splats_accumulated.get(), light_paths, integrator.splat_scale());
-    };
-    // Light paths the pass's camera samples splatted (an integrator's own pass body counts its own).
-    auto camera_sample_light_paths = [&] {
-        return integrator.renders_passes() ? 0.0 : integrator.light_paths_per_sample() * double(samples_done);
-    };
-    double last_checkpoint = elapsed(), last_snapshot = 0;
-    bool checkpointed_at_stop = false;
-    auto counted = [&] {
-        RenderCounters sum = counters_before;
-        for (const RenderCounters &t : counters) sum += t;
-        return sum;
-    };
-    RenderCounters counted_at_pass_start;  // what a checkpoint of a pass cut short holds
-    auto make_checkpoint = [&](const RenderCounters &counted_so_far) {
-        RenderCheckpoint c;
-        c.spp = result.spp;
-        c.passes = result.passes;
-        c.render_time_s = elapsed();
-        c.seconds_per_spp = seconds_per_spp;
-        c.light_paths = light_paths;
-        c.counters = counted_so_far;
-        c.image_sums = accumulated.sums();
-        if (splatting) c.splat_sums = splats_accumulated->sums();
-        c.integrator_state = integrator.save_state();
-        return c;
-    };
-    auto checkpoint = [&](const RenderCounters &counted_so_far) {
-        job.on_checkpoint(make_checkpoint(counted_so_far), current_image());
-        last_checkpoint = elapsed();
-    };
-    for (;;) {
-        if (job.cancel && job.cancel->load()) { result.stopped_by = "cancel"; break; }
-        double remaining = timed ? job.time_limit_s - elapsed() : 0;
-        if (timed && remaining <= 0) { result.stopped_by = "time"; break; }
-        int size = next_pass_size(result.spp, job.spp, seconds_per_spp, remaining, timed,
-                                  integrator.learns_between_passes());
-        if (size <= 0) { result.stopped_by = (job.spp > 0 && result.spp >= job.spp) ? "spp" : "time"; break; }
-
-        const int s0 = result.spp;
-        if (job.on_checkpoint) counted_at_pass_start = counted();
-        pass_block.clear();
-        samples_done = 0;
-        pass_size_now = size;
-        std::atomic<bool> aborted{false};
-        // A time limit cuts a pass short only when it overruns badly (the first pass, whose speed was
-        // unknown, or a wrong estimate): otherwise the pass, sized to fit, is finished.
-        auto must_stop = [&] {
-            const bool overrun = timed && (result.passes == 0 ? elapsed() > job.time_limit_s
-                                                              : elapsed() > 1.25 * job.time_limit_s);
-            if ((job.cancel && job.cancel->load()) || overrun) aborted = true;
-            return aborted.load(std::memory_order_relaxed);
-        };
-        const double pass_start = elapsed();
-        // Light paths splatted apart from the camera samples (BDPT's NEE++ pool before the pass) or the
-        // samples of an integrator's own pass body.
-        uint64_t pass_light_paths = 0;
-        double one_off_s = 0;
-        const PassInfo info{result.passes, s0, size, uint64_t(W) * H * size, job.seed};
-        if (splatting) {
-            splats_pass->clear();
-            if (!integrator.renders_passes())
-                arena.execute([&] { pass_light_paths = integrator.begin_pass(scene, info, *splats_pass, counters.local()); });
-        }
-        if (integrator.renders_passes()) {
-            const PassControl control{must_stop, &samples_done, &one_off_s};
-            arena.execute([&] { pass_light_paths = integrator.render_pass(scene, info, *splats_pass, counters.local(), control); });
-        } else arena.execute([&] {
-            tbb::parallel_for(tbb::blocked_range<size_t>(0, tiles.size(), 1), [&](const tbb::blocked_range<size_t> &r) {
-                const DenormalsAreZero ftz;
-                // Samples go to the integrator in batches (see Integrator::Li_batch), each with its own sampler.
-                std::vector<std::unique_ptr<Sampler>> owned;
-                std::vector<Sampler *> samplers;
-                for (int k = 0; k < kBatch; ++k) samplers.push_back(owned.emplace_back(prototype->clone()).get());
-                std::vector<Ray> rays(kBatch);
-                std::vector<Vec2> film_pos(kBatch);
-                std::vector<Color> radiance(kBatch);
-                RenderCounters &c = counters.local();
-                for (size_t ti = r.begin(); ti != r.end(); ++ti) {
-                    if (aborted.load(std::memory_order_relaxed) || must_stop()) return;
-                    const Tile &t = tiles[ti];
-                    double m2 = 0;
-                    ImageBlock block(t.x0 - border, t.y0 - border, t.w + 2 * border, t.h + 2 * border, &filter);
-                    int queued = 0;
-                    auto add = [&](const Vec2 &pos, Color L) {
-                        // Only NaN/inf are dropped: negative values are legitimate for unbiased
-                        // estimators such as NEE++'s control variate and must average out.
-                        if (!is_finite(L)) {
-                            ++c.invalid_samples;
-                            L = Color(0.f);
-                        }
-                        block.put(pos.x, pos.y, L);
-                        m2 += double(luminance(L)) * double(luminance(L));
-                    };
-                    auto flush = [&] {
-                        integrator.Li_batch(scene, std::span<const Ray>(rays.data(), queued),
-                                            std::span<Sampler *const>(samplers.data(), queued),
-                                            std::span<Color>(radiance.data(), queued), c);
-                        for (int k = 0; k < queued; ++k) add(film_pos[k], radiance[k]);
-                        queued = 0;
-                    };
-                    for (int y = t.y0; y < t.y0 + t.h; ++y)
-                        for (int x = t.x0; x < t.x0 + t.w; ++x)
-                            for (int s = s0; s < s0 + size; ++s) {
-                                Sampler &sampler = *samplers[queued];
-                                // Film pixels, so that a crop's pixels draw what the whole film's do.
-                                sampler.start_sample(uint32_t(x + cam.crop_x), uint32_t(y + cam.crop_y), uint32_t(s));
-                                Vec2 jitter = sampler.next_2d();
-                                film_pos[queued] = Vec2(float(x) + jitter.x, float(y) + jitter.y);
-                                // As Mitsuba: a lens's sample follows the film position's.
-                                const Vec2 lens = cam.has_lens() ? sampler.next_2d() : Vec2(0.5f, 0.5f);
-                                rays[queued] = cam.pixel_ray(x, y, jitter, lens);
-                                if (splatting) {
-                                    add(film_pos[queued], integrator.Li_splat(scene, rays[queued], sampler, c, *splats_pass));
-                                    continue;
-                                }
-                                if (++queued == kBatch) flush();
-                            }
-                    if (queued > 0) flush();
-                    tile_m2[ti] = m2;
-                    samples_done += uint64_t(t.w) * t.h * size;
-                    std::lock_guard<std::mutex> lock(merge_mutex);
-                    pass_block.merge(block);
-                }
-            });
-        });
-        if (aborted) {
-            // A checkpoint holds whole passes: the one cut short is not in it (nor in a resumed image).
-            if (job.on_checkpoint && result.passes > 0) checkpoint(counted_at_pass_start);
-            checkpointed_at_stop = true;
-            // Keep a partial first pass rather than nothing at all: every pixel it reached is unbiased.
-            if (result.passes == 0) {
-                accumulated.merge(pass_block);
-                if (splatting) {
-                    splats_accumulated->merge(*splats_pass);
-                    light_paths += double(pass_light_paths) + camera_sample_light_paths();
-                }
-            }
-            result.stopped_by = (job.cancel && job.cancel->load()) ? "cancel" : "time";
-            break;
-        }
-        accumulated.merge(pass_block);
-        if (splatting) {
-            splats_accumulated->merge(*splats_pass);
-            light_paths += double(pass_light_paths) + camera_sample_light_paths();
-        }
-        result.spp += size;
-        spp_done_now = result.spp;
-        integrator.end_pass(scene, pass_statistics(result.passes, result.spp, size, tile_m2, accumulated));
-        ++result.passes;
-        seconds_per_spp = std::max(elapsed() - pass_start - one_off_s, 0.0) / size;
-        if (job.on_snapshot && (last_snapshot == 0 || elapsed() >= job.snapshot_growth * last_snapshot)) {
-            last_snapshot = elapsed();
-            job.on_snapshot(result.spp, last_snapshot, current_image());
-        }
-        if (job.spp > 0 && result.spp >= job.spp) { result.stopped_by = "spp"; break; }
-        if (job.on_checkpoint && elapsed() - last_checkpoint >= job.checkpoint_interval_s) checkpoint(counted());
-    }
-    // Stopped before its sample count between passes (time, Ctrl-C): what a resume continues from.
-    if (job.on_checkpoint && result.stopped_by != "spp" && !checkpointed_at_stop && result.passes > 0) checkpoint(counted());
-    pass_size_now = 0;
-    bar.finish();
-
-    result.render_time_s = elapsed();
-    result.render_cpu_time_s = cpu_seconds(CpuClock::process) - cpu_start;
-    result.counters = counted();
-    result.occlusion_time_s = double(result.counters.occlusion_ticks) * seconds_per_tick();
-    result.image = current_image();
-    if (job.keep_state) result.state = make_checkpoint(result.counters);
-    return result;
+    return RenderLoop(scene, integrator, job).run();
 }
 
 Image image_from_sums(const Scene &scene, const std::vector<double> &image_sums, const std::vector<int64_t> &splat_sums,
