@@ -132,7 +132,7 @@ nb::dict render_range(const Scene &scene, const std::string &integrator_name,
                       int threads, const std::string &sampler, const nb::bytes &state, nb::object progress) {
     if (first < 0 || last <= first) throw std::invalid_argument("render_range: the range must be 0 <= first < last");
     std::unique_ptr<Integrator> integrator = scene_integrator(scene, integrator_name, overrides);
-    if (integrator->renders_passes())
+    if (dynamic_cast<const PassIntegrator *>(integrator.get()))
         throw std::invalid_argument("integrator '" + integrator->describe().value("name", std::string()) +
                                     "' renders whole passes itself (its Markov chains), which cannot be split by sample index");
     RenderJob job = make_job(scene, last, 0, seed, threads, sampler);

@@ -10,6 +10,7 @@
 // in most paths it touches, and fails the first check.
 #include <gtest/gtest.h>
 #include <cmath>
+#include "neepp/integrators/ray_batch.h"
 #include "neepp/io/image.h"
 #include "neepp/sampling/sampler.h"
 #include "neepp/scene/scene.h"
@@ -147,11 +148,15 @@ SampleAgreement compare_samples(const Family &family, const OptionMap &o) {
     }
     SampleAgreement a;
     std::vector<Color> fast(kSamples);
-    integrator->Li_batch(*scene, rays, samplers, fast, a.fast);
+    const auto &path = dynamic_cast<const RayIntegrator &>(*integrator);
+    const RayBatch *batch = path.batch();
+    EXPECT_NE(batch, nullptr) << "the fast form renders by default";
+    if (!batch) return a;
+    batch->Li_batch(*scene, rays, samplers, fast, a.fast);
     auto single = make_sampler("independent", 7);
     for (int i = 0; i < kSamples; ++i) {
         const Ray ray = start(*single, i);
-        const Color L = integrator->Li(*scene, ray, *single, a.reference);
+        const Color L = path.Li(*scene, ray, *single, a.reference);
         bool exact = true, close = true;
         for (int c = 0; c < 3; ++c) {
             exact &= L[c] == fast[i][c];
@@ -196,8 +201,10 @@ TEST(PathForms, SameRadianceSampleBySample) {
 // sampling alone and NEE, of the same image): sample by sample they must disagree.
 TEST(PathForms, SampleCheckSeesADifferentEstimator) {
     auto scene = load_scene(write_temp_scene(kGlossyRoomXml));
-    auto nee = make_integrator("path", with_scene_options(*scene, {}));
-    auto bsdf_only = make_integrator("path", with_scene_options(*scene, {{"nee", "false"}}));
+    auto nee_owned = make_integrator("path", with_scene_options(*scene, {}));
+    auto bsdf_only_owned = make_integrator("path", with_scene_options(*scene, {{"nee", "false"}}));
+    auto *nee = dynamic_cast<RayIntegrator *>(nee_owned.get());
+    auto *bsdf_only = dynamic_cast<RayIntegrator *>(bsdf_only_owned.get());
     nee->prepare(*scene);
     bsdf_only->prepare(*scene);
     const Camera &cam = scene->camera;
@@ -237,6 +244,7 @@ TEST(PathForms, SameImageInExpectation) {
 TEST(PathForms, FormIsAnOption) {
     auto reference = make_integrator("path", Options(OptionMap{{"form", "reference"}}));
     EXPECT_EQ(reference->describe()["form"], "reference");
+    EXPECT_EQ(dynamic_cast<RayIntegrator &>(*reference).batch(), nullptr) << "the render loop then calls Li";
     EXPECT_EQ(make_integrator("path", Options())->describe()["form"], "fast");
     EXPECT_THROW(make_integrator("path", Options(OptionMap{{"form", "wavefront"}})), std::invalid_argument);
 }

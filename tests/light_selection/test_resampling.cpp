@@ -129,7 +129,7 @@ PointEstimate estimate_at_point(const OptionMap &options, Map setup, int n) {
     double s = 0, s2 = 0;
     for (int i = 0; i < n; ++i) {
         sampler->start_sample(0, 0, uint32_t(i));
-        const double l = luminance(integ->Li(*scene, ray, *sampler, counters));
+        const double l = luminance(dynamic_cast<const RayIntegrator &>(*integ).Li(*scene, ray, *sampler, counters));
         s += l;
         s2 += l * l;
     }

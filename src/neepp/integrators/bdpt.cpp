@@ -364,12 +364,8 @@ Color BDPTIntegrator::visible_environment(const Scene &scene, const Ray &ray, Re
     return Le;
 }
 
-Color BDPTIntegrator::Li(const Scene &, const Ray &, Sampler &, RenderCounters &) const {
-    throw std::logic_error("bdpt: renders through Li_splat (its t = 1 strategies splat onto the film)");
-}
-
-Color BDPTIntegrator::Li_splat(const Scene &scene, const Ray &ray, Sampler &sampler, RenderCounters &counters,
-                               SplatSink &splats) const {
+Color BDPTIntegrator::Li(const Scene &scene, const Ray &ray, Sampler &sampler, RenderCounters &counters,
+                         SplatSink &splats) const {
     thread_local std::vector<PathVertex> camera, light;
     // Each part of the sample on its own stream (Sampler::use_stream): PSSMLT's mutations stay local.
     if (options_.light_tracer) {

@@ -44,14 +44,12 @@ struct BDPTOptions {
     int voxels = 16;
 };
 
-class BDPTIntegrator final : public Integrator {
+class BDPTIntegrator final : public SplattingIntegrator {
 public:
     BDPTIntegrator(BDPTOptions options, std::unique_ptr<ShadowRayTester> shadow);
     void prepare(const Scene &scene) override;
-    Color Li(const Scene &scene, const Ray &ray, Sampler &sampler, RenderCounters &counters) const override;
-    bool splats() const override { return true; }
-    Color Li_splat(const Scene &scene, const Ray &ray, Sampler &sampler, RenderCounters &counters,
-                   SplatSink &splats) const override;
+    Color Li(const Scene &scene, const Ray &ray, Sampler &sampler, RenderCounters &counters,
+             SplatSink &splats) const override;
     uint64_t begin_pass(const Scene &scene, const PassInfo &pass, SplatFilm &splats, RenderCounters &counters) override;
     void end_pass(const Scene &scene, const PassStatistics &pass) override;
     bool learns_between_passes() const override { return shadow_->learns_between_passes(); }

@@ -85,7 +85,7 @@ std::unique_ptr<Integrator> make_bdpt(bool light_tracer, const Options &options)
     return std::make_unique<BDPTIntegrator>(o, std::move(shadow));
 }
 
-std::unique_ptr<Integrator> make_path(const Options &options) {
+std::unique_ptr<PathIntegrator> make_path(const Options &options) {
     PathOptions o;
     o.max_depth = options.get_int("max_depth", o.max_depth);
     o.rr_depth = options.get_int("rr_depth", o.rr_depth);

@@ -5,7 +5,6 @@
 #include <atomic>
 #include <functional>
 #include <memory>
-#include <stdexcept>
 #include <span>
 #include <string>
 #include <nlohmann/json.hpp>
@@ -20,6 +19,7 @@ class Scene;
 class Sampler;
 class SplatFilm;
 class SplatSink;
+class RayBatch;
 
 // What the render loop tells an integrator before a pass.
 struct PassInfo {
@@ -30,7 +30,7 @@ struct PassInfo {
     uint64_t seed = 0;
 };
 
-// What the render loop gives an integrator that renders its passes itself (Integrator::render_pass).
+// What the render loop gives an integrator that renders its passes itself (PassIntegrator::render_pass).
 struct PassControl {
     std::function<bool()> stop;                // true once the pass must end (cancel, time overrun)
     std::atomic<uint64_t> *samples_done = nullptr;  // samples completed this pass, for the progress bar
@@ -39,51 +39,14 @@ struct PassControl {
     double *one_off_s = nullptr;
 };
 
+// What every integrator is to the render loop: hooks around its passes, what it learns between them, and
+// its description. How it renders a pass is its family's (below): exactly one of RayIntegrator,
+// SplattingIntegrator and PassIntegrator.
 class Integrator {
 public:
     virtual ~Integrator() = default;
     // Called once before rendering starts (build tables, seed maps).
     virtual void prepare(const Scene &scene) {}
-    virtual Color Li(const Scene &scene, const Ray &ray, Sampler &sampler, RenderCounters &counters) const = 0;
-    // The same for a batch of camera rays, each with its own sampler (set up for its pixel and sample),
-    // results in out. The default calls Li for each; an integrator that gains from having many paths in
-    // flight (to hide memory latency) overrides it, and must give exactly what Li gives.
-    virtual void Li_batch(const Scene &scene, std::span<const Ray> rays, std::span<Sampler *const> samplers,
-                          std::span<Color> out, RenderCounters &counters) const {
-        for (size_t i = 0; i < rays.size(); ++i) out[i] = Li(scene, rays[i], *samplers[i], counters);
-    }
-    // Integrators whose samples also add to other pixels than their own (light tracing, BDPT's t = 1
-    // strategies) say so; the render loop then calls Li_splat, one sample at a time, with the pass's splat
-    // film, and adds the splats to the image scaled by pixels / light paths.
-    virtual bool splats() const { return false; }
-    virtual Color Li_splat(const Scene &scene, const Ray &ray, Sampler &sampler, RenderCounters &counters,
-                           SplatSink &splats) const {
-        return Li(scene, ray, sampler, counters);
-    }
-    // Light paths whose camera connections each camera sample splats (1: its own light path; 0 when the
-    // light paths are traced apart, before the pass, as BDPT's NEE++ pool is).
-    virtual double light_paths_per_sample() const { return 1; }
-    // Called before each pass, from the render loop's thread arena (it may run in parallel inside): BDPT's
-    // NEE++ selection traces its pool of light paths here. Returns how many light paths it splatted into
-    // `splats`, which count toward the splats' normalization.
-    virtual uint64_t begin_pass(const Scene &scene, const PassInfo &pass, SplatFilm &splats, RenderCounters &counters) {
-        return 0;
-    }
-    // Integrators that are not one path per pixel (PSSMLT) supply the pass body themselves: the render
-    // loop keeps the budget, passes, progress, cancellation, checkpoints and statistics, and calls
-    // render_pass in place of its tile loop (and of begin_pass). A pass is pass.camera_samples samples,
-    // every one splatted (splats() must say true); the body adds the samples it completes to
-    // control.samples_done as it goes (the progress bar reads it), and returns early once control.stop()
-    // says so. Returns how many samples it splatted: they count toward the splats' normalization as light
-    // paths do.
-    virtual bool renders_passes() const { return false; }
-    // A factor on the splat layer that the integrator learns as the render goes (PSSMLT's normalization,
-    // refined by every pass), read whenever the image is formed.
-    virtual double splat_scale() const { return 1.0; }
-    virtual uint64_t render_pass(const Scene &scene, const PassInfo &pass, SplatFilm &splats,
-                                 RenderCounters &counters, const PassControl &control) {
-        throw std::logic_error("this integrator renders through the render loop's tile loop");
-    }
     // Called between passes, single-threaded, after all samples of the pass are in.
     virtual void end_pass(const Scene &scene, const PassStatistics &pass) {}
     // Whether end_pass changes what later samples do (NEE++ publishes a new map): the render loop then
@@ -105,6 +68,60 @@ public:
     // Extra statistics of this integrator (map size, rays skipped...), merged into the stats file.
     virtual nlohmann::json statistics() const { return nlohmann::json::object(); }
 };
+
+// Integrators that estimate the radiance arriving along each camera ray, one pixel sample at a time (path):
+// the render loop's tile loop calls Li. A fast form that evaluates many camera rays at once is a side
+// interface (RayBatch, integrators/ray_batch.h), which the render loop uses where batch() offers one.
+class RayIntegrator : public Integrator {
+public:
+    virtual Color Li(const Scene &scene, const Ray &ray, Sampler &sampler, RenderCounters &counters) const = 0;
+    // The fast form for the coming pass, or null: Li alone. Asked after prepare() and after each end_pass().
+    virtual const RayBatch *batch() const { return nullptr; }
+};
+
+// Integrators whose camera samples also add to other pixels than their own (light tracing, BDPT's t = 1
+// strategies): the render loop calls Li with the pass's splat film, and adds the splats to the image
+// scaled by pixels / light paths.
+class SplattingIntegrator : public Integrator {
+public:
+    virtual Color Li(const Scene &scene, const Ray &ray, Sampler &sampler, RenderCounters &counters,
+                     SplatSink &splats) const = 0;
+    // Light paths whose camera connections each camera sample splats (1: its own light path; 0 when the
+    // light paths are traced apart, before the pass, as BDPT's NEE++ pool is).
+    virtual double light_paths_per_sample() const { return 1; }
+    // Called before each pass, from the render loop's thread arena (it may run in parallel inside): BDPT's
+    // NEE++ selection traces its pool of light paths here. Returns how many light paths it splatted into
+    // `splats`, which count toward the splats' normalization.
+    virtual uint64_t begin_pass(const Scene &scene, const PassInfo &pass, SplatFilm &splats, RenderCounters &counters) {
+        return 0;
+    }
+};
+
+// Integrators that are not one path per pixel (PSSMLT) and supply the pass body themselves: the render
+// loop keeps the budget, passes, progress, cancellation, checkpoints and statistics, and calls render_pass
+// in place of its tile loop. A pass is pass.camera_samples samples, every one splatted; the body adds the
+// samples it completes to control.samples_done as it goes (the progress bar reads it), and returns early
+// once control.stop() says so. Returns how many samples it splatted: they count toward the splats'
+// normalization as light paths do.
+class PassIntegrator : public Integrator {
+public:
+    virtual uint64_t render_pass(const Scene &scene, const PassInfo &pass, SplatFilm &splats, RenderCounters &counters,
+                                 const PassControl &control) = 0;
+    // A factor on the splat layer that the integrator learns as the render goes (PSSMLT's normalization,
+    // refined by every pass), read whenever the image is formed.
+    virtual double splat_scale() const { return 1.0; }
+};
+
+// The radiance of each of a batch of camera rays, each with its own sampler (set up for its pixel and
+// sample), into out: through the integrator's fast form where it has one, else Li one ray at a time.
+void Li_batch(const RayIntegrator &integrator, const Scene &scene, std::span<const Ray> rays,
+              std::span<Sampler *const> samplers, std::span<Color> out, RenderCounters &counters);
+// One camera sample of a ray or splatting integrator (its splats, if any, into splats); PSSMLT's chains
+// evaluate their inner integrator this way. Throws std::invalid_argument for a PassIntegrator.
+Color Li_sample(const Integrator &integrator, const Scene &scene, const Ray &ray, Sampler &sampler,
+                RenderCounters &counters, SplatSink &splats);
+// Whether the integrator's samples splat: a SplattingIntegrator's or a PassIntegrator's.
+bool splats(const Integrator &integrator);
 
 class ShadowRayTester;
 // The shadow-ray component of an integrator, from the options every integrator shares (shadow_rays and

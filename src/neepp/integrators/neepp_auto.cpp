@@ -23,7 +23,7 @@ NeeppShadowRays *map_keeper(Integrator &integrator) {
     return path ? dynamic_cast<NeeppShadowRays *>(&path->shadow_rays()) : nullptr;
 }
 
-// The pilot: kPilotSpp samples of each pixel of a grid over the film, through Li_batch as the render
+// The pilot: kPilotSpp samples of each pixel of a grid over the film, through the fast form as the render
 // loop calls it. The numbers depend on (pixel, sample) only, so every candidate sees the same camera
 // rays and, wherever its choices agree with another's, the same paths: the differences between their
 // variances are less noisy than the variances.
@@ -32,7 +32,7 @@ struct PilotFigures {
     double sample_variance = 0;  // per sample, of a pixel's luminance (PassStatistics::sample_variance)
 };
 
-PilotFigures run_pilot(const Scene &scene, const Integrator &integrator, int first_sample) {
+PilotFigures run_pilot(const Scene &scene, const RayIntegrator &integrator, int first_sample) {
     const Camera &cam = scene.camera;
     const int gx = std::min(AutoIntegrator::kPilotGrid, cam.width), gy = std::min(AutoIntegrator::kPilotGrid, cam.height);
     constexpr int K = AutoIntegrator::kPilotSpp;
@@ -57,7 +57,7 @@ PilotFigures run_pilot(const Scene &scene, const Integrator &integrator, int fir
                 const Vec2 lens = cam.has_lens() ? s.next_2d() : Vec2(0.5f, 0.5f);
                 rays[k] = cam.pixel_ray(x, y, jitter, lens);
             }
-            integrator.Li_batch(scene, rays, samplers, out, counters);
+            Li_batch(integrator, scene, rays, samplers, out, counters);
             double m = 0, m2 = 0;
             for (const Color &c : out) {
                 const double l = is_finite(c) ? double(luminance(c)) : 0.0;
@@ -120,7 +120,7 @@ void AutoIntegrator::prepare(const Scene &scene) {
     }
     // Plain NEE and the most efficient other candidate so far, prepared; the rest are dropped at once
     // (each holds its own map).
-    std::unique_ptr<Integrator> nee, best;
+    std::unique_ptr<RayIntegrator> nee, best;
     double nee_efficiency = 0, best_efficiency = 0;
     size_t best_k = 0;
     // The map is seeded once, by the first candidate that seeds one in prepare; the others start from a
@@ -128,7 +128,7 @@ void AutoIntegrator::prepare(const Scene &scene) {
     std::optional<std::pair<VoxelGrid, VisibilityMap>> seeded;
     for (size_t k = 0; k < candidates_.size(); ++k) {
         if (!candidates_[k].applies(scene)) continue;
-        std::unique_ptr<Integrator> integrator = make_(candidates_[k]);
+        std::unique_ptr<RayIntegrator> integrator = make_(candidates_[k]);
         NeeppShadowRays *keeper = map_keeper(*integrator);
         if (keeper && seeded) keeper->adopt_map(seeded->first, seeded->second);
         // Prepared, then a first pilot pass that is not measured: what a candidate builds on first use

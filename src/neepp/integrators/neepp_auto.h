@@ -32,9 +32,9 @@ struct AutoPilotResult {
     double prepare_s = 0;           // wall time to build its tables and map, and of the unmeasured first pilot pass
 };
 
-class AutoIntegrator final : public Integrator {
+class AutoIntegrator final : public RayIntegrator {
 public:
-    using Make = std::function<std::unique_ptr<Integrator>(const AutoCandidate &)>;
+    using Make = std::function<std::unique_ptr<RayIntegrator>(const AutoCandidate &)>;
     // make: builds a candidate's integrator (its maps are built by its prepare, only if it applies).
     AutoIntegrator(std::vector<AutoCandidate> candidates, Make make);
 
@@ -48,10 +48,7 @@ public:
     Color Li(const Scene &scene, const Ray &ray, Sampler &sampler, RenderCounters &counters) const override {
         return chosen().Li(scene, ray, sampler, counters);
     }
-    void Li_batch(const Scene &scene, std::span<const Ray> rays, std::span<Sampler *const> samplers,
-                  std::span<Color> out, RenderCounters &counters) const override {
-        chosen().Li_batch(scene, rays, samplers, out, counters);
-    }
+    const RayBatch *batch() const override { return chosen().batch(); }
     void end_pass(const Scene &scene, const PassStatistics &pass) override { chosen().end_pass(scene, pass); }
     bool learns_between_passes() const override { return chosen().learns_between_passes(); }
     // The state starts with the pick, so that a resumed render, and every worker of a distributed one,
@@ -66,11 +63,11 @@ public:
     const std::vector<AutoPilotResult> &pilot() const { return pilot_; }
 
 private:
-    Integrator &chosen() const { return *chosen_integrator_; }
+    RayIntegrator &chosen() const { return *chosen_integrator_; }
     void choose(const Scene &scene, size_t k);  // builds and prepares candidate k unless it is the one held
     std::vector<AutoCandidate> candidates_;
     Make make_;
-    std::unique_ptr<Integrator> chosen_integrator_;
+    std::unique_ptr<RayIntegrator> chosen_integrator_;
     size_t chosen_ = 0;
     std::vector<AutoPilotResult> pilot_;
     std::string why_;

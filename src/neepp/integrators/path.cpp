@@ -15,7 +15,11 @@
 namespace neepp {
 
 PathIntegrator::PathIntegrator(PathOptions options, std::unique_ptr<ShadowRayTester> shadow)
-    : options_(std::move(options)), shadow_(std::move(shadow)) {}
+    : options_(std::move(options)), shadow_(std::move(shadow)), batch_(std::make_unique<PathBatch>(*this)) {}
+
+PathIntegrator::~PathIntegrator() = default;
+
+const RayBatch *PathIntegrator::batch() const { return options_.reference ? nullptr : batch_.get(); }
 
 void PathIntegrator::prepare(const Scene &scene) {
     // The factory keeps a map for a sampler that may read one; on a scene where it does not (one light),
@@ -223,15 +227,6 @@ Color PathIntegrator::Li(const Scene &scene, const Ray &camera_ray, Sampler &sam
         if (!(max_component(beta) > 0)) break;
     }
     return L;
-}
-
-void PathIntegrator::Li_batch(const Scene &scene, std::span<const Ray> rays, std::span<Sampler *const> samplers,
-                              std::span<Color> out, RenderCounters &counters) const {
-    if (options_.reference) {
-        Integrator::Li_batch(scene, rays, samplers, out, counters);
-        return;
-    }
-    PathBatch(*this).run(scene, rays, samplers, out, counters);
 }
 
 }  // namespace neepp

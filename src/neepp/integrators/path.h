@@ -34,9 +34,12 @@ struct PathOptions {
     bool reference = false;
 };
 
-class PathIntegrator final : public Integrator {
+class PathBatch;
+
+class PathIntegrator final : public RayIntegrator {
 public:
     explicit PathIntegrator(PathOptions options, std::unique_ptr<ShadowRayTester> shadow);
+    ~PathIntegrator() override;
     void prepare(const Scene &scene) override;
     void end_pass(const Scene &scene, const PassStatistics &pass) override;
     // While the shadow-ray policy reads or updates its visibility map (which the light sampler may read too).
@@ -51,11 +54,10 @@ public:
     // The reference form: one path, one vertex at a time, every choice made where it reads (path.cpp).
     // It defines what the path tracer computes; the fast form below is tested against it.
     Color Li(const Scene &scene, const Ray &ray, Sampler &sampler, RenderCounters &counters) const override;
-    // The fast form (PathBatch, path_batch.cpp): the batch's paths advance in lockstep, stage by stage, so
+    // The fast form (PathBatch, path_batch.h): the batch's paths advance in lockstep, stage by stage, so
     // that cache prefetches and packets of rays pay. Same random numbers in the same order per path as Li.
-    // With form=reference it renders through Li instead.
-    void Li_batch(const Scene &scene, std::span<const Ray> rays, std::span<Sampler *const> samplers,
-                  std::span<Color> out, RenderCounters &counters) const override;
+    // None with form=reference: the render loop then calls Li.
+    const RayBatch *batch() const override;
     nlohmann::json describe() const override;
     const PathOptions &options() const { return options_; }
     const ShadowRayTester &shadow_rays() const { return *shadow_; }
@@ -91,6 +93,7 @@ private:
     std::unique_ptr<ShadowRayTester> shadow_;
     const ShadowRayTester *queries_ = nullptr;  // shadow_->query_tester() for the coming pass
     std::unique_ptr<LightSampler> light_sampler_;
+    std::unique_ptr<PathBatch> batch_;
     WithinLightSampling within_light_;
     ResamplingVisibility resampling_visibility_;
 };

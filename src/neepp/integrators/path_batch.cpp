@@ -257,7 +257,7 @@ bool PathBatch::finish_vertex(Path &path) const {
     return max_component(path.beta) > 0;
 }
 
-void PathBatch::run(const Scene &scene, std::span<const Ray> rays, std::span<Sampler *const> samplers,
+void PathBatch::Li_batch(const Scene &scene, std::span<const Ray> rays, std::span<Sampler *const> samplers,
                               std::span<Color> out, RenderCounters &counters) const {
     constexpr size_t kBatch = 32;
     // The paths' slots live as long as the thread: built once, not at every call (a call takes only 32

@@ -8,16 +8,17 @@
 #pragma once
 #include <span>
 #include "neepp/integrators/path.h"
+#include "neepp/integrators/ray_batch.h"
 
 namespace neepp {
 
 class LightSampleLanes;
 
-class PathBatch {
+class PathBatch final : public RayBatch {
 public:
     explicit PathBatch(const PathIntegrator &integrator) : pi_(integrator) {}
-    void run(const Scene &scene, std::span<const Ray> rays, std::span<Sampler *const> samplers, std::span<Color> out,
-             RenderCounters &counters) const;
+    void Li_batch(const Scene &scene, std::span<const Ray> rays, std::span<Sampler *const> samplers,
+                  std::span<Color> out, RenderCounters &counters) const override;
 
 private:
     struct Candidate;  // one light sample of next event estimation

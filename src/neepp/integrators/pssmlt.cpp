@@ -45,7 +45,8 @@ void record(SplatFilm &film, const std::vector<PSSMLTIntegrator::Contribution> &
 
 PSSMLTIntegrator::PSSMLTIntegrator(PSSMLTOptions options, std::unique_ptr<Integrator> inner)
     : options_(options), inner_(std::move(inner)) {
-    if (inner_->renders_passes()) throw std::invalid_argument("pssmlt: the inner integrator must render per sample");
+    if (dynamic_cast<const PassIntegrator *>(inner_.get()))
+        throw std::invalid_argument("pssmlt: the inner integrator must render per sample");
 }
 
 void PSSMLTIntegrator::prepare(const Scene &scene) {
@@ -55,10 +56,6 @@ void PSSMLTIntegrator::prepare(const Scene &scene) {
     f_sum_ = pass_f_sum_ = 0;
     f_samples_ = pass_f_samples_ = 0;
     mutations_ = accepted_ = large_steps_ = large_accepted_ = zero_proposals_ = 0;
-}
-
-Color PSSMLTIntegrator::Li(const Scene &, const Ray &, Sampler &, RenderCounters &) const {
-    throw std::logic_error("pssmlt: renders its passes itself (render_pass)");
 }
 
 float PSSMLTIntegrator::evaluate(const Scene &scene, PrimarySampleSpaceSampler &sampler, std::vector<Contribution> &out,
@@ -71,13 +68,7 @@ float PSSMLTIntegrator::evaluate(const Scene &scene, PrimarySampleSpaceSampler &
     const Vec2 lens = cam.has_lens() ? sampler.next_2d() : Vec2(0.5f, 0.5f);
     const Ray ray = cam.generate_ray(u, lens);
     ContributionList splats(out);
-    Color L;
-    if (inner_->splats()) {
-        L = inner_->Li_splat(scene, ray, sampler, counters, splats);
-    } else {  // the inner integrator's own form (path: the fast one, a batch of one path, unless form=reference)
-        Sampler *const samplers[1] = {&sampler};
-        inner_->Li_batch(scene, std::span<const Ray>(&ray, 1), samplers, std::span<Color>(&L, 1), counters);
-    }
+    const Color L = Li_sample(*inner_, scene, ray, sampler, counters, splats);
     if (is_finite(L)) out.push_back({Vec2(u.x * float(cam.width), u.y * float(cam.height)), L});
     else ++counters.invalid_samples;
     float f = 0;

@@ -36,13 +36,10 @@ struct PSSMLTOptions {
     float sigma = 0.01f;        // standard deviation of a small step's offset of each number
 };
 
-class PSSMLTIntegrator final : public Integrator {
+class PSSMLTIntegrator final : public PassIntegrator {
 public:
     PSSMLTIntegrator(PSSMLTOptions options, std::unique_ptr<Integrator> inner);
     void prepare(const Scene &scene) override;
-    Color Li(const Scene &scene, const Ray &ray, Sampler &sampler, RenderCounters &counters) const override;
-    bool splats() const override { return true; }
-    bool renders_passes() const override { return true; }
     uint64_t render_pass(const Scene &scene, const PassInfo &pass, SplatFilm &splats, RenderCounters &counters,
                          const PassControl &control) override;
     void end_pass(const Scene &scene, const PassStatistics &pass) override;

@@ -22,7 +22,7 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
-// Camera samples handed to the integrator at once (Integrator::Li_batch).
+// Camera samples handed to a ray integrator at once (RayIntegrator::batch).
 constexpr int kBatch = 32;
 
 struct Tile {
@@ -129,7 +129,7 @@ public:
         // statistics and for the result (12 each), the PNG's bytes (4); with splats, two splat films (24
         // bytes each) and the splat layer resolved (12).
         check_film_fits_in_memory(scene.camera.width, scene.camera.height,
-                                  2 * 32 + 2 * 12 + 4 + (integrator.splats() ? 2 * 24 + 12 : 0));
+                                  2 * 32 + 2 * 12 + 4 + (splats(integrator) ? 2 * 24 + 12 : 0));
     }
 
     RenderLoop(const Scene &scene, Integrator &integrator, const RenderJob &job);
@@ -144,10 +144,10 @@ private:
     void merge_pass(uint64_t pass_light_paths);
     // Light paths the pass's camera samples splatted (an integrator's own pass body counts its own).
     double camera_sample_light_paths() const {
-        return integrator_.renders_passes() ? 0.0 : integrator_.light_paths_per_sample() * double(samples_done_);
+        return splatter_ ? splatter_->light_paths_per_sample() * double(samples_done_) : 0.0;
     }
     Image current_image() const {
-        return combine_layers(accumulated_, splats_accumulated_.get(), light_paths_, integrator_.splat_scale());
+        return combine_layers(accumulated_, splats_accumulated_.get(), light_paths_, passes_ ? passes_->splat_scale() : 1.0);
     }
     RenderCounters counted() const {
         RenderCounters sum = counters_before_;
@@ -165,7 +165,11 @@ private:
     const RenderJob &job_;
     const Camera &cam_;
     const int W_, H_;
-    const bool splatting_;
+    // The integrator's family (integrators/integrator.h): one of the three is set.
+    RayIntegrator *const ray_;
+    SplattingIntegrator *const splatter_;
+    PassIntegrator *const passes_;
+    const bool splatting_;  // the image has a splat layer (a splatting or a pass integrator)
     ReconstructionFilter filter_;
     int border_ = 0;  // how far a sample's filter reaches beyond its pixel
     // The image (samples, and the splat layer of integrators whose samples add to other pixels, scaled by
@@ -196,7 +200,8 @@ private:
 
 RenderLoop::RenderLoop(const Scene &scene, Integrator &integrator, const RenderJob &job)
     : scene_(scene), integrator_(integrator), job_(job), cam_(scene.camera), W_(cam_.width), H_(cam_.height),
-      splatting_(integrator.splats()),
+      ray_(dynamic_cast<RayIntegrator *>(&integrator)), splatter_(dynamic_cast<SplattingIntegrator *>(&integrator)),
+      passes_(dynamic_cast<PassIntegrator *>(&integrator)), splatting_(splats(integrator)),
       filter_(scene.settings.rfilter, scene.settings.rfilter_radius, scene.settings.rfilter_stddev),
       accumulated_((check_job(scene, integrator, job), 0), 0, W_, H_, &filter_), pass_block_(0, 0, W_, H_, &filter_),
       tiles_(make_tiles(W_, H_, job.tile_size)), tile_m2_(tiles_.size()),
@@ -294,16 +299,16 @@ bool RenderLoop::render_pass(int size) {
     const PassInfo info{result_.passes, s0, size, uint64_t(W_) * H_ * size, job_.seed};
     if (splatting_) {
         splats_pass_->clear();
-        if (!integrator_.renders_passes())
-            arena_.execute([&] { pass_light_paths = integrator_.begin_pass(scene_, info, *splats_pass_, counters_.local()); });
+        if (splatter_)
+            arena_.execute([&] { pass_light_paths = splatter_->begin_pass(scene_, info, *splats_pass_, counters_.local()); });
     }
-    if (integrator_.renders_passes()) {
+    if (passes_) {
         const PassControl control{must_stop, &samples_done_, &one_off_s_};
-        arena_.execute([&] { pass_light_paths = integrator_.render_pass(scene_, info, *splats_pass_, counters_.local(), control); });
+        arena_.execute([&] { pass_light_paths = passes_->render_pass(scene_, info, *splats_pass_, counters_.local(), control); });
     } else arena_.execute([&] {
         tbb::parallel_for(tbb::blocked_range<size_t>(0, tiles_.size(), 1), [&](const tbb::blocked_range<size_t> &r) {
             const DenormalsAreZero ftz;
-            // Samples go to the integrator in batches (see Integrator::Li_batch), each with its own sampler.
+            // Samples go to the integrator in batches (its fast form, RayIntegrator::batch), each with its own sampler.
             std::vector<std::unique_ptr<Sampler>> owned;
             std::vector<Sampler *> samplers;
             for (int k = 0; k < kBatch; ++k) samplers.push_back(owned.emplace_back(prototype_->clone()).get());
@@ -342,7 +347,7 @@ void RenderLoop::render_tile(size_t index, int s0, int size, std::vector<Sampler
         m2 += double(luminance(L)) * double(luminance(L));
     };
     auto flush = [&] {
-        integrator_.Li_batch(scene_, std::span<const Ray>(rays.data(), queued),
+        Li_batch(*ray_, scene_, std::span<const Ray>(rays.data(), queued),
                              std::span<Sampler *const>(samplers.data(), queued), std::span<Color>(radiance.data(), queued), c);
         for (int k = 0; k < queued; ++k) add(film_pos[k], radiance[k]);
         queued = 0;
@@ -358,8 +363,8 @@ void RenderLoop::render_tile(size_t index, int s0, int size, std::vector<Sampler
                 // As Mitsuba: a lens's sample follows the film position's.
                 const Vec2 lens = cam_.has_lens() ? sampler.next_2d() : Vec2(0.5f, 0.5f);
                 rays[queued] = cam_.pixel_ray(x, y, jitter, lens);
-                if (splatting_) {
-                    add(film_pos[queued], integrator_.Li_splat(scene_, rays[queued], sampler, c, *splats_pass_));
+                if (splatter_) {
+                    add(film_pos[queued], splatter_->Li(scene_, rays[queued], sampler, c, *splats_pass_));
                     continue;
                 }
                 if (++queued == kBatch) flush();
