@@ -1,4 +1,6 @@
 #include <algorithm>
+#include <map>
+#include <mutex>
 #include <set>
 #include <sstream>
 #include <stdexcept>
@@ -149,7 +151,31 @@ std::unique_ptr<Integrator> make_auto_path(const Options &options) {
     return std::make_unique<AutoIntegrator>(auto_candidates(),
                                             [candidate_options](const AutoCandidate &c) { return make_path(candidate_options(c)); });
 }
+
+
+std::mutex registry_mutex;
+std::map<std::string, IntegratorPlugin> &registry() {
+    static std::map<std::string, IntegratorPlugin> r;
+    return r;
+}
+
+const IntegratorPlugin *find_registered(const std::string &name) {
+    std::lock_guard<std::mutex> lock(registry_mutex);
+    auto it = registry().find(name);
+    return it == registry().end() ? nullptr : &it->second;
+}
+
 }  // namespace
+
+void register_integrator(const std::string &name, IntegratorPlugin make) {
+    for (const char *own : {"path", "bdpt", "light", "pssmlt"})
+        if (name == own) throw std::invalid_argument("register_integrator: '" + name + "' is one of neepp's own");
+    if (name.empty()) throw std::invalid_argument("register_integrator: an integrator needs a name");
+    std::lock_guard<std::mutex> lock(registry_mutex);
+    registry()[name] = std::move(make);
+}
+
+bool integrator_registered(const std::string &name) { return find_registered(name) != nullptr; }
 
 std::unique_ptr<Integrator> make_integrator(const std::string &name, const Options &options) {
     std::unique_ptr<Integrator> integrator;
@@ -185,6 +211,9 @@ std::unique_ptr<Integrator> make_integrator(const std::string &name, const Optio
             throw std::invalid_argument("pssmlt (over " + over + "): " + e.what());
         }
         integrator = std::make_unique<PSSMLTIntegrator>(o, std::move(inner));
+    } else if (const IntegratorPlugin *make = find_registered(name)) {
+        integrator = (*make)(options);
+        if (!integrator) throw std::invalid_argument("the registered integrator '" + name + "' made nothing");
     } else {
         throw std::invalid_argument("unknown integrator '" + name + "' (supported: path, bdpt, light, pssmlt)");
     }

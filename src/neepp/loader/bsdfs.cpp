@@ -2,6 +2,7 @@
 #include <optional>
 #include "neepp/loader/supported_plugins.h"
 #include "neepp/loader/factories.h"
+#include "neepp/loader/plugins.h"
 #include "neepp/materials/blendbsdf.h"
 #include "neepp/materials/bumpmap.h"
 #include "neepp/materials/conductor.h"
@@ -286,6 +287,9 @@ BSDFPtr Factories::create_bsdf(const XmlNode &node) {
         b = std::make_shared<PrincipledBSDF>(principled_params(node));
     } else if (t == "principledthin") {
         b = std::make_shared<PrincipledThinBSDF>(principled_thin_params(node));
+    } else if (const BSDFPlugin *plugin = find_bsdf_plugin(t)) {
+        b = (*plugin)(PluginProperties(node, *this));
+        if (!b) throw node.error("the '" + t + "' plugin built no BSDF");
     } else {
         throw node.error("unsupported BSDF type '" + t + "' (supported: " + supported_list("bsdf") + ")");
     }

@@ -45,6 +45,17 @@ private:
     BSDFPtr default_bsdf_, black_bsdf_;
 };
 
+// f(), with any error it throws that does not say where (a plugin's, a constructor's) located at node.
+template <typename F> auto located_at(const XmlNode &node, F &&f) -> decltype(f()) {
+    try {
+        return f();
+    } catch (const SceneError &) {
+        throw;
+    } catch (const std::exception &e) {
+        throw node.error(e.what());
+    }
+}
+
 // The scene's <integrator>: its type and options, with Mitsuba 3's integrators mapped to the one here
 // that renders the same image (prb, volpath without media, direct, ptracer, the moment wrapper), said
 // in one line on stderr.

@@ -1,6 +1,7 @@
 #include <algorithm>
 #include <set>
 #include <fmt/core.h>
+#include "neepp/integrators/integrator.h"
 #include "neepp/loader/factories.h"
 #include "neepp/loader/supported_plugins.h"
 
@@ -128,7 +129,7 @@ void load_integrator(const XmlNode &node, RenderSettings &settings) {
         n = &unwrap(*n, not_written);
     }
     const std::vector<std::string> &known = supported_names("integrator");
-    if (std::find(known.begin(), known.end(), n->type) == known.end())
+    if (std::find(known.begin(), known.end(), n->type) == known.end() && !integrator_registered(n->type))
         throw n->error("unsupported integrator '" + n->type + "' (supported: " + supported_list("integrator") + ")");
     settings.integrator = n->type;
     settings.integrator_options.clear();

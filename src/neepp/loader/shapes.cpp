@@ -13,6 +13,7 @@
 #include "neepp/lights/spot_light.h"
 #include "neepp/math/frame.h"
 #include "neepp/loader/factories.h"
+#include "neepp/loader/plugins.h"
 #include "neepp/loader/problems.h"
 #include "neepp/materials/bitmap_texture.h"
 #include "neepp/scene/sdf_grid.h"
@@ -253,6 +254,19 @@ void set_mesh(Shape &s, MeshData mesh, const Transform &to_world) {
     if (!s.face_normals && s.normals.empty()) compute_vertex_normals(s);
 }
 
+// A registered shape's mesh is checked as a mesh file's is: indices in range and by threes, one normal
+// and one uv per position where there are any, finite positions.
+void check_mesh(const MeshData &m, const XmlNode &node) {
+    auto bad = [&](const std::string &what) { return node.error("the '" + node.type + "' plugin built a bad mesh: " + what); };
+    if (m.indices.size() % 3 != 0) throw bad("its index count is not a multiple of 3");
+    for (uint32_t i : m.indices)
+        if (i >= m.positions.size()) throw bad("index " + std::to_string(i) + " is past its " + std::to_string(m.positions.size()) + " positions");
+    if (!m.normals.empty() && m.normals.size() != m.positions.size()) throw bad("it has normals, but not one per position");
+    if (!m.uvs.empty() && m.uvs.size() != m.positions.size()) throw bad("it has uvs, but not one per position");
+    for (const Vec3 &p : m.positions)
+        if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z)) throw bad("a position is not finite");
+}
+
 // Whether the shape has a surface: a mesh with no triangles, or only degenerate ones (a scale of 0,
 // collinear vertices), has none, and an emitter on it would be a light of zero area, which neither
 // light sampling nor emission sampling can sample a point of.
@@ -347,6 +361,10 @@ std::unique_ptr<Shape> Factories::build_shape(const XmlNode &node, const XmlNode
             s->kind = Shape::Kind::SdfGrid;
             s->sdf_grid = load_sdf_grid(node);
             transform_shape(*s, to_world);
+        } else if (const ShapePlugin *plugin = find_shape_plugin(t)) {
+            MeshData mesh = (*plugin)(PluginProperties(node, *this));
+            check_mesh(mesh, node);
+            set_mesh(*s, std::move(mesh), to_world);
         } else {
             throw node.error("unsupported shape type '" + t + "' (supported: " + supported_list("shape") + ")");
         }
@@ -433,6 +451,10 @@ void Factories::emitter(const XmlNode &node, Scene &scene) {
         }
     } else if (t == "area") {
         throw node.error("an 'area' emitter must be nested inside a <shape>");
+    } else if (const EmitterPlugin *plugin = find_emitter_plugin(t)) {
+        LightPtr light = located_at(node, [&] { return (*plugin)(PluginProperties(node, *this)); });
+        if (!light) throw node.error("the '" + t + "' plugin built no emitter");
+        scene.add_light(std::move(light));
     } else {
         throw node.error("unsupported emitter type '" + t + "' (supported: " + supported_list("emitter") + ")");
     }

@@ -1,6 +1,7 @@
 #include "neepp/loader/supported_plugins.h"
 
 #include <stdexcept>
+#include "neepp/loader/plugins.h"
 
 namespace neepp {
 
@@ -34,6 +35,7 @@ const std::vector<std::string> &supported_names(const std::string &kind) {
 std::string supported_list(const std::string &kind) {
     std::string list;
     for (const std::string &n : supported_names(kind)) list += (list.empty() ? "" : ", ") + n;
+    for (const std::string &n : registered_plugins(kind)) list += ", " + n + " (registered)";
     return list;
 }
 

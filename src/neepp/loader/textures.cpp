@@ -1,6 +1,7 @@
 #include <fmt/core.h>
 #include "neepp/loader/supported_plugins.h"
 #include "neepp/loader/factories.h"
+#include "neepp/loader/plugins.h"
 #include "neepp/loader/problems.h"
 #include "neepp/materials/bitmap_texture.h"
 #include "neepp/materials/checkerboard_texture.h"
@@ -50,6 +51,9 @@ TexturePtr Factories::texture(const XmlNode &node) {
         bool scalar = node.props.at("value").kind == XmlProperty::Kind::Float ||
                       node.props.at("value").kind == XmlProperty::Kind::Integer;
         tex = constant_texture(scalar ? Color(node.get_float("value")) : Color(node.get_vector("value")));
+    } else if (const TexturePlugin *plugin = find_texture_plugin(node.type)) {
+        tex = located_at(node, [&] { return (*plugin)(PluginProperties(node, *this)); });
+        if (!tex) throw node.error("the '" + node.type + "' plugin built no texture");
     } else {
         throw node.error("unsupported texture type '" + node.type + "' (supported: " + supported_list("texture") + ")");
     }
