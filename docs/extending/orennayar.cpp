@@ -38,10 +38,12 @@ public:
         return bs;
     }
     uint32_t flags() const override { return BSDFDiffuseReflection; }
+    // Its value reads only the azimuths' difference, not which way the tangent points: hits on its shapes
+    // may get the cheaper frame built from the normal alone.
+    bool needs_tangents() const override { return false; }
 
 private:
-    // A + B max(0, cos(φi - φo)) sin α tan β, with α the larger of θi, θo and β the smaller. It reads only
-    // the azimuths' difference: the shading frame's tangent may point anywhere.
+    // A + B max(0, cos(φi - φo)) sin α tan β, with α the larger of θi, θo and β the smaller.
     float facets(const Vec3 &wi, const Vec3 &wo) const {
         const float sin_i = std::sqrt(std::max(0.f, 1.f - wi.z * wi.z));
         const float sin_o = std::sqrt(std::max(0.f, 1.f - wo.z * wo.z));

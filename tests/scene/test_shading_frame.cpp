@@ -58,6 +58,18 @@ TEST(ShadingFrame, WhichBsdfsNeedTangents) {
     EXPECT_TRUE(make_quad(std::make_shared<TwoSidedBSDF>(bump, nullptr)).tangents);
 }
 
+// A BSDF that does not say whether it reads the tangent (a new plugin's) gets the full frame: the default
+// is right for every BSDF, the cheaper frame is an opt-in.
+TEST(ShadingFrame, ABsdfThatDoesNotSayGetsTangents) {
+    struct Plain final : BSDF {
+        Color eval(const BSDFContext &, const SurfaceInteraction &, const Vec3 &, const Vec3 &) const override { return Color(0.f); }
+        float pdf(const BSDFContext &, const SurfaceInteraction &, const Vec3 &, const Vec3 &) const override { return 0.f; }
+        BSDFSample sample(const BSDFContext &, const SurfaceInteraction &, const Vec3 &, float, Vec2) const override { return {}; }
+        uint32_t flags() const override { return BSDFGlossyReflection; }
+    };
+    EXPECT_TRUE(make_quad(std::make_shared<Plain>()).tangents);
+}
+
 TEST(ShadingFrame, SameNormalAndUvWithOrWithoutTangents) {
     auto diffuse = std::make_shared<DiffuseBSDF>(constant_texture(Color(0.5f)));
     const Shape plain = make_quad(diffuse);

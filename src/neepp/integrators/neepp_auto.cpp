@@ -91,11 +91,10 @@ const std::vector<AutoCandidate> &auto_candidates() {
         // it (NEE++'s visibility-aware selection, paper §3); the default light BVH knows bounds only.
         {"light-spatial", {{"light_sampler", "spatial-oriented"}}, several_lights},
         {"light-visibility", {{"light_sampler", "visibility"}}, several_lights},
-        // Not candidates: within_light=visibility and shadow_rays=neepp-adaptive. Their pilot figures did
-        // not predict a render's (classroom: 1.5-2.2x plain NEE's efficiency in the pilot, 0.9x over 128
-        // spp; their variance comes from rare bright paths that a pilot sees or misses), and where they
-        // win a whole render they win by less (1.2x) than the margin that keeps the pilot's noise from
-        // picking a loser (docs/neepp.md).
+        // Not candidates: within_light=visibility and shadow_rays=neepp-adaptive. Their pilot figures do
+        // not predict a render's (their variance comes from rare bright paths that a pilot sees or misses),
+        // and where they win a whole render they win by less than the margin that keeps the pilot's noise
+        // from picking a loser (docs/neepp.md has the measurements).
     };
     return candidates;
 }

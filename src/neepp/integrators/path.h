@@ -17,14 +17,14 @@ struct PathOptions {
     int rr_depth = 5;
     bool hide_emitters = false;
     bool nee = true;
-    std::string light_sampler = "bvh";  // pbrt-v4's default too; measured best of the non-NEE++ choices (docs/neepp.md)
+    std::string light_sampler = "bvh";  // pbrt-v4's default too; the best of the non-NEE++ choices (docs/neepp.md)
     std::string within_light = "own";  // how a point on the chosen light is sampled (WithinLightSampling)
     int voxels = 16;  // grid of the spatial light sampler when NEE++ keeps no map (else the map's grid)
     // Resampled NEE (light_selection/resampling.h): ris light-sample candidates per vertex, one chosen by
     // f·Le·max(√Ṽ, ris_floor) for the shadow ray (1 = plain NEE), at the path's first ris_depth vertices
     // (-1: all) and plain NEE beyond. By default at the camera's first hit only: there a candidate costs
-    // what it costs deeper, and it buys the most (deeper vertices' noise is mostly the path's own), so it
-    // was the most efficient depth on six of the seven scenes measured (docs/neepp.md).
+    // what it costs deeper, and it buys the most (deeper vertices' noise is mostly the path's own): the
+    // most efficient depth on most scenes measured (docs/neepp.md).
     static constexpr int kMaxCandidates = 32;
     int ris = 1;
     float ris_floor = 0.05f;  // as q_min: a wrong map costs at most a factor 1/ris_floor in a sample's weight

@@ -76,9 +76,10 @@ public:
     // A hint for batched integrators, issued well before shading; it never changes a result.
     virtual void prefetch(const SurfaceInteraction &si) const {}
     // Whether evaluating or sampling reads si.dpdu / si.dpdv or depends on which way the shading frame's
-    // tangent points (bump maps, anisotropic roughness). When no BSDF of a shape does, its hits get a
-    // shading frame built from the normal alone, without the uv derivatives and the Gram-Schmidt step.
-    virtual bool needs_tangents() const { return false; }
+    // tangent points (bump maps, anisotropic roughness). A BSDF that does not may say false: its shapes'
+    // hits then get a shading frame built from the normal alone, without the uv derivatives and the
+    // Gram-Schmidt step, which is cheaper. The default, true, is right for every BSDF.
+    virtual bool needs_tangents() const { return true; }
     bool has_flag(uint32_t f) const { return (flags() & f) != 0; }
 };
 
@@ -86,6 +87,7 @@ public:
 // density, so they can only be sampled, never evaluated.
 class DeltaOnlyBSDF : public BSDF {
 public:
+    bool needs_tangents() const override { return false; }  // smooth interfaces: the normal alone
     Color eval(const BSDFContext &, const SurfaceInteraction &, const Vec3 &, const Vec3 &) const final {
         return Color(0.f);
     }

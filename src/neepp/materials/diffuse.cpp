@@ -4,20 +4,10 @@
 
 namespace neepp {
 
-Color DiffuseBSDF::eval(const BSDFContext &, const SurfaceInteraction &si, const Vec3 &wi, const Vec3 &wo) const {
-    if (cos_theta(wi) <= 0 || cos_theta(wo) <= 0) return Color(0.f);
-    return reflectance_->eval(si) * (kInvPi * cos_theta(wo));
-}
-
-float DiffuseBSDF::pdf(const BSDFContext &, const SurfaceInteraction &, const Vec3 &wi, const Vec3 &wo) const {
-    if (cos_theta(wi) <= 0 || cos_theta(wo) <= 0) return 0.f;
-    return square_to_cosine_hemisphere_pdf(wo);
-}
-
 BSDFEval DiffuseBSDF::eval_pdf(const BSDFContext &, const SurfaceInteraction &si, const Vec3 &wi,
                                const Vec3 &wo) const {
     if (cos_theta(wi) <= 0 || cos_theta(wo) <= 0) return {};
-    return {reflectance_->eval(si) * (kInvPi * cos_theta(wo)), square_to_cosine_hemisphere_pdf(wo)};
+    return {reflectance_->eval(si) * (kInvPi * cos_theta(wo)), density(wi, wo)};
 }
 
 BSDFSample DiffuseBSDF::sample(const BSDFContext &, const SurfaceInteraction &si, const Vec3 &wi, float,

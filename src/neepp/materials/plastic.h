@@ -26,6 +26,7 @@ public:
     BSDFSample sample(const BSDFContext &, const SurfaceInteraction &si, const Vec3 &wi, float u1,
                       Vec2 u2) const override;
     uint32_t flags() const override { return BSDFDeltaReflection | BSDFDiffuseReflection; }
+    bool needs_tangents() const override { return false; }
     void prefetch(const SurfaceInteraction &si) const override { prefetch_textures(si, diffuse_reflectance_, specular_reflectance_); }
 
 private:

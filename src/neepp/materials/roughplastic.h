@@ -28,6 +28,7 @@ public:
     BSDFSample sample(const BSDFContext &ctx, const SurfaceInteraction &si, const Vec3 &wi, float u1,
                       Vec2 u2) const override;
     uint32_t flags() const override { return BSDFGlossyReflection | BSDFDiffuseReflection; }
+    bool needs_tangents() const override { return false; }  // isotropic
     void prefetch(const SurfaceInteraction &si) const override { prefetch_textures(si, diffuse_reflectance_, specular_reflectance_); }
 
     static constexpr int kTransmittanceRes = 64;

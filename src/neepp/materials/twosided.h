@@ -37,6 +37,7 @@ public:
         return pass_through(wi, 1.f, transmittance_ ? transmittance_->eval(si) * scale_ : Color(1.f));
     }
     uint32_t flags() const override { return BSDFNull; }
+    bool needs_tangents() const override { return false; }
     void prefetch(const SurfaceInteraction &si) const override { prefetch_textures(si, transmittance_); }
 
     // The null event: wo = -wi, chosen with probability pdf, carrying weight.
