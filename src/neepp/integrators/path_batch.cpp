@@ -66,7 +66,8 @@ struct PathBatch::Path {
 };
 
 bool PathBatch::begin_vertex(const Scene &scene, Path &path) const {
-    const bool show_emission = path.depth > 0 || !pi_.options_.hide_emitters;
+    const PathIntegrator &pi = pi_;  // a local: the stages' stores through path cannot alias it
+    const bool show_emission = path.depth > 0 || !pi.options_.hide_emitters;
     const Ray &ray = path.ray;
     if (!path.hit.valid()) {
         if (show_emission)
@@ -74,7 +75,7 @@ bool PathBatch::begin_vertex(const Scene &scene, Path &path) const {
                 Color Le = env->eval_environment(ray.d);
                 if (is_black(Le)) continue;
                 float w = path.prev_delta ? 1.f
-                                          : pi_.emission_weight(*env, path.prev, direction_sample_from_miss(ray.d),
+                                          : pi.emission_weight(*env, path.prev, direction_sample_from_miss(ray.d),
                                                             path.prev_bsdf_pdf);
                 path.L += path.beta * Le * w;
             }
@@ -85,23 +86,23 @@ bool PathBatch::begin_vertex(const Scene &scene, Path &path) const {
         Color Le = area->eval_surface(si, -ray.d);
         if (!is_black(Le)) {
             float w = path.prev_delta ? 1.f
-                                      : pi_.emission_weight(*area, path.prev, direction_sample_from_hit(path.prev.p, si),
+                                      : pi.emission_weight(*area, path.prev, direction_sample_from_hit(path.prev.p, si),
                                                         path.prev_bsdf_pdf);
             path.L += path.beta * Le * w;
         }
     }
-    if (pi_.options_.max_depth >= 0 && path.depth + 1 >= pi_.options_.max_depth) return false;
+    if (pi.options_.max_depth >= 0 && path.depth + 1 >= pi.options_.max_depth) return false;
 
     const BSDF &bsdf = *si.shape->bsdf;
     bsdf.prefetch(si);
     path.ctx = PathIntegrator::light_context(si, ray.d);
-    path.nee = pi_.options_.nee && (si.shape->bsdf_flags & BSDFSmooth);
-    path.m = pi_.candidates_at(path.depth);
+    path.nee = pi.options_.nee && (si.shape->bsdf_flags & BSDFSmooth);
+    path.m = pi.candidates_at(path.depth);
     if (!path.nee) return true;
     const int M = path.m;
     if (M == 1) {
         Candidate &c = path.candidates[0];
-        c.light = pi_.light_sampler_->sample(path.ctx, path.sampler->next_1d());
+        c.light = pi.light_sampler_->sample(path.ctx, path.sampler->next_1d());
         c.start.u = path.sampler->next_2d();
     } else {  // each candidate's numbers in the order one candidate takes them, then the choice's; the
               // lights chosen together (the light BVH's shared descent)
@@ -112,13 +113,13 @@ bool PathBatch::begin_vertex(const Scene &scene, Path &path) const {
             path.candidates[i].start.u = path.sampler->next_2d();
         }
         path.u_choice = path.sampler->next_1d();
-        pi_.light_sampler_->sample_many(path.ctx, u, M, lights);
+        pi.light_sampler_->sample_many(path.ctx, u, M, lights);
         for (int i = 0; i < M; ++i) path.candidates[i].light = lights[i];
     }
     path.chosen = 0;
     for (int i = 0; i < M; ++i) {
         Candidate &c = path.candidates[i];
-        c.within = c.light.light ? pi_.within_light_.for_light(*c.light.light) : nullptr;
+        c.within = c.light.light ? pi.within_light_.for_light(*c.light.light) : nullptr;
         if (c.within) c.within->prefetch(path.ctx, c.start.u);
         else if (c.light.light) c.light.light->prefetch_sample(c.start.u);
     }
@@ -156,10 +157,11 @@ void PathBatch::sample_light(Path &path, LightSampleLanes &lanes) const {
 }
 
 void PathBatch::weigh_candidates(Path &path) const {
+    const PathIntegrator &pi = pi_;  // a local: the stages' stores through path cannot alias it
     if (!path.nee || path.m == 1) return;
     const SurfaceInteraction &si = path.si;
     const BSDF &bsdf = *si.shape->bsdf;
-    path.cell = pi_.resampling_visibility_.shading_cell(si.p);
+    path.cell = pi.resampling_visibility_.shading_cell(si.p);
     for (int i = 0; i < path.m; ++i) {
         Candidate &c = path.candidates[i];
         const DirectionSample &ds = c.sample.ds;
@@ -168,19 +170,20 @@ void PathBatch::weigh_candidates(Path &path) const {
         c.bsdf = bsdf.eval_pdf(BSDFContext{}, si, si.wi, si.to_local(ds.d));
         c.target = luminance(c.bsdf.f * c.sample.radiance);
         if (!(c.target > 0.f)) continue;
-        c.cell = pi_.resampling_visibility_.light_cell(ds);
-        pi_.resampling_visibility_.prefetch(path.cell, c.cell);  // read by resample, after the batch's other paths
+        c.cell = pi.resampling_visibility_.light_cell(ds);
+        pi.resampling_visibility_.prefetch(path.cell, c.cell);  // read by resample, after the batch's other paths
     }
 }
 
 void PathBatch::resample(Path &path) const {
+    const PathIntegrator &pi = pi_;  // a local: the stages' stores through path cannot alias it
     if (!path.nee || path.m == 1) return;
     float w[PathOptions::kMaxCandidates];
     for (int i = 0; i < path.m; ++i) {
         Candidate &c = path.candidates[i];
         w[i] = 0.f;
         if (!(c.target > 0.f)) continue;
-        c.target *= pi_.resampling_visibility_(path.cell, c.cell);
+        c.target *= pi.resampling_visibility_(path.cell, c.cell);
         const float wi = c.target / (c.light.pmf * c.sample.ds.pdf);
         if (std::isfinite(wi)) w[i] = wi;
     }
@@ -193,6 +196,7 @@ void PathBatch::resample(Path &path) const {
 }
 
 bool PathBatch::begin_direct(Path &path) const {
+    const PathIntegrator &pi = pi_;  // a local: the stages' stores through path cannot alias it
     if (!path.nee) return false;
     const Candidate &c = path.candidates[path.chosen];
     const SampledLight &sl = c.light;
@@ -212,27 +216,30 @@ bool PathBatch::begin_direct(Path &path) const {
     q.to = ds.p;
     if (resampled) {
         q.unoccluded = path.beta * f * Le * (w * path.ris_weight);
-        if (pi_.resampling_visibility_.uses_map()) q.from_cell = path.cell, q.to_cell = c.cell;  // located already
+        if (pi.resampling_visibility_.uses_map()) q.from_cell = path.cell, q.to_cell = c.cell;  // located already
     } else {
         q.unoccluded = path.beta * f * Le * (w / light_pdf);
     }
-    pi_.queries_->prepare(q);
+    pi.queries_->prepare(q);
     return true;
 }
 
 bool PathBatch::decide_direct(Path &path, RenderCounters &counters) const {
-    path.test = pi_.queries_->begin_test(path.shadow, *path.sampler, counters);
+    const PathIntegrator &pi = pi_;  // a local: the stages' stores through path cannot alias it
+    path.test = pi.queries_->begin_test(path.shadow, *path.sampler, counters);
     if (path.test.trace) return true;
     path.L += path.shadow.unoccluded * path.test.if_skipped;
     return false;
 }
 
 void PathBatch::end_direct(Path &path, bool occluded) const {
-    pi_.queries_->end_test(path.test, occluded);
+    const PathIntegrator &pi = pi_;  // a local: the stages' stores through path cannot alias it
+    pi.queries_->end_test(path.test, occluded);
     path.L += path.shadow.unoccluded * path.test.weight(occluded);
 }
 
 bool PathBatch::finish_vertex(Path &path) const {
+    const PathIntegrator &pi = pi_;  // a local: the stages' stores through path cannot alias it
     const SurfaceInteraction &si = path.si;
     const BSDF &bsdf = *si.shape->bsdf;
     Sampler &sampler = *path.sampler;
@@ -249,7 +256,7 @@ bool PathBatch::finish_vertex(Path &path) const {
     ++path.depth;
 
     // Russian roulette on the throughput (times eta^2 so refraction does not trigger it), Mitsuba's rule.
-    if (path.depth >= pi_.options_.rr_depth) {
+    if (path.depth >= pi.options_.rr_depth) {
         float q = std::min(max_component(path.beta) * path.eta * path.eta, 0.95f);
         if (!(sampler.next_1d() < q)) return false;
         path.beta /= q;
@@ -259,6 +266,7 @@ bool PathBatch::finish_vertex(Path &path) const {
 
 void PathBatch::Li_batch(const Scene &scene, std::span<const Ray> rays, std::span<Sampler *const> samplers,
                               std::span<Color> out, RenderCounters &counters) const {
+    const PathIntegrator &pi = pi_;  // a local: the stages' stores through path cannot alias it
     constexpr size_t kBatch = 32;
     // The paths' slots live as long as the thread: built once, not at every call (a call takes only 32
     // samples, and building 32 slots of ~0.5 KB each every time is a cost for nothing). Path::start
@@ -271,7 +279,7 @@ void PathBatch::Li_batch(const Scene &scene, std::span<const Ray> rays, std::spa
     thread_local std::unique_ptr<Slots> slots;
     if (!slots) slots = std::make_unique<Slots>();
     auto &[paths, active, pending, candidates] = *slots;
-    const size_t M = size_t(pi_.options_.ris);
+    const size_t M = size_t(pi.options_.ris);
     if (candidates.size() < kBatch * M) candidates.resize(kBatch * M);
     for (size_t base = 0; base < rays.size(); base += kBatch) {
         const size_t n = std::min(kBatch, rays.size() - base);
@@ -310,7 +318,7 @@ void PathBatch::Li_batch(const Scene &scene, std::span<const Ray> rays, std::spa
             LightSampleLanes light_lanes;
             for (size_t k = 0; k < shading; ++k) sample_light(paths[active[k]], light_lanes);
             light_lanes.flush();
-            if (pi_.resampling()) {
+            if (pi.resampling()) {
                 for (size_t k = 0; k < shading; ++k) weigh_candidates(paths[active[k]]);
                 for (size_t k = 0; k < shading; ++k) resample(paths[active[k]]);
             }

@@ -6,8 +6,9 @@ namespace neepp {
 
 BSDFEval DiffuseBSDF::eval_pdf(const BSDFContext &, const SurfaceInteraction &si, const Vec3 &wi,
                                const Vec3 &wo) const {
-    if (cos_theta(wi) <= 0 || cos_theta(wo) <= 0) return {};
-    return {reflectance_->eval(si) * (kInvPi * cos_theta(wo)), density(wi, wo)};
+    const float pdf = density(wi, wo);
+    if (!(pdf > 0)) return {};
+    return {reflectance_->eval(si) * (kInvPi * cos_theta(wo)), pdf};
 }
 
 BSDFSample DiffuseBSDF::sample(const BSDFContext &, const SurfaceInteraction &si, const Vec3 &wi, float,
