@@ -4,8 +4,8 @@
 // scene), which covers every option's parsing and validation.
 #include <exception>
 #include <sstream>
-#include "neepp/integrators/integrator.h"
-#include "neepp/integrators/options.h"
+#include "neepp/base/options.h"
+#include "neepp/integrators/factory.h"
 #include "fuzz_input.h"
 
 extern "C" int LLVMFuzzerInitialize(int *, char ***) {

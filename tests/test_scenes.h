@@ -6,7 +6,7 @@
 #include <fstream>
 #include <string>
 #include <vector>
-#include "neepp/integrators/integrator.h"
+#include "neepp/integrators/factory.h"
 #include "neepp/loader/scene_loader.h"
 #include "neepp/render/render_loop.h"
 

@@ -12,12 +12,12 @@
 #include <unistd.h>
 #include <CLI/CLI.hpp>
 #include <fmt/core.h>
-#include "neepp/integrators/integrator.h"
+#include "neepp/integrators/factory.h"
 #include "neepp/integrators/option_table.h"
-#include "neepp/loader/supported_plugins.h"
 #include "neepp/io/atomic_file.h"
 #include "neepp/light_selection/factory.h"
 #include "neepp/loader/scene_loader.h"
+#include "neepp/loader/supported_plugins.h"
 #include "neepp/render/huge_pages.h"
 #include "neepp/render/render_output.h"
 #include "neepp/visibility/map_file.h"

@@ -1,9 +1,9 @@
 // An integrator: ambient occlusion, the fraction of the hemisphere above the first hit that is open within
 // a distance, weighted by the cosine. A RayIntegrator defines Li, one camera ray at a time; the render loop
 // owns threads, passes, time, progress and checkpoints.
-#include "neepp/integrators/integrator.h"
+#include "neepp/base/stats.h"
+#include "neepp/integrators/factory.h"
 #include "neepp/math/warp.h"
-#include "neepp/render/stats.h"
 #include "neepp/sampling/sampler.h"
 #include "neepp/scene/scene.h"
 

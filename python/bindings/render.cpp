@@ -13,7 +13,7 @@
 #include <nanobind/stl/string.h>
 #include <nanobind/stl/vector.h>
 #include "bindings.h"
-#include "neepp/integrators/integrator.h"
+#include "neepp/integrators/factory.h"
 #include "neepp/render/render_output.h"
 #include "neepp/scene/scene.h"
 

@@ -6,7 +6,7 @@
 #include <gtest/gtest.h>
 #include <cmath>
 #include "../../docs/extending/examples.h"
-#include "neepp/integrators/integrator.h"
+#include "neepp/integrators/factory.h"
 #include "neepp/loader/plugins.h"
 #include "neepp/math/warp.h"
 #include "neepp/sampling/rng.h"

@@ -3,7 +3,7 @@
 #include <gtest/gtest.h>
 #include <set>
 #include <map>
-#include "neepp/integrators/integrator.h"
+#include "neepp/integrators/factory.h"
 #include "neepp/integrators/option_table.h"
 
 using namespace neepp;

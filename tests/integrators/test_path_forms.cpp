@@ -10,7 +10,7 @@
 // in most paths it touches, and fails the first check.
 #include <gtest/gtest.h>
 #include <cmath>
-#include "neepp/integrators/ray_batch.h"
+#include "neepp/base/ray_batch.h"
 #include "neepp/io/image.h"
 #include "neepp/sampling/sampler.h"
 #include "neepp/scene/scene.h"

@@ -1,9 +1,9 @@
 // LightBounds: cone unions hold both cones, and the importance bound is conservative: wherever it is
 // zero, no point of the light can send light to the receiver (else the BVH sampler would be biased).
 #include <gtest/gtest.h>
+#include "neepp/base/light_bounds.h"
+#include "neepp/base/texture.h"
 #include "neepp/lights/area_light.h"
-#include "neepp/lights/light_bounds.h"
-#include "neepp/materials/texture.h"
 #include "neepp/math/warp.h"
 #include "neepp/sampling/rng.h"
 

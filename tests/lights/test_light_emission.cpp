@@ -3,6 +3,7 @@
 // carry the light's flux (E[Le |cos| / (pdf_pos pdf_dir)] is the emitted power).
 #include <gtest/gtest.h>
 #include "common/chi2.h"
+#include "neepp/base/texture.h"
 #include "neepp/lights/area_light.h"
 #include "neepp/lights/directional_light.h"
 #include "neepp/lights/environment_light.h"
@@ -10,7 +11,6 @@
 #include "neepp/lights/spot_light.h"
 #include "neepp/materials/bitmap_texture.h"
 #include "neepp/math/frame.h"
-#include "neepp/materials/texture.h"
 #include "neepp/sampling/rng.h"
 
 using namespace neepp;

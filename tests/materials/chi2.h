@@ -4,7 +4,7 @@
 #include <string>
 #include <cstdint>
 #include "common/chi2.h"
-#include "neepp/materials/bsdf.h"
+#include "neepp/base/bsdf.h"
 
 namespace neepp::test {
 

@@ -4,6 +4,7 @@
 #include <tbb/blocked_range.h>
 #include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
+#include "neepp/light_selection/basic_light_samplers.h"
 #include "neepp/lights/environment_light.h"
 #include "neepp/render/film.h"
 #include "neepp/sampling/sampler.h"
@@ -244,7 +245,7 @@ Color BDPTIntegrator::connect(const std::vector<PathVertex> &light, const std::v
     q.from = from->p;
     q.to = to->infinite ? from->p + to->dir : to->p;  // a ray to the sky is mapped by its direction
     q.unoccluded = L;
-    return L * queries_->visibility(*ctx_.scene, q, sampler, counters);
+    return L * test_visibility(*queries_, *ctx_.scene, q, sampler, counters);
 }
 
 void BDPTIntegrator::splat_light_path(const std::vector<PathVertex> &light, Sampler &sampler, RenderCounters &counters,

@@ -23,7 +23,7 @@
 #include <memory>
 #include <string>
 #include <vector>
-#include "neepp/integrators/integrator.h"
+#include "neepp/base/integrator.h"
 #include "neepp/integrators/path_vertex.h"
 #include "neepp/visibility/shadow_ray_tester.h"
 

@@ -1,3 +1,5 @@
+#include "neepp/integrators/factory.h"
+
 #include <algorithm>
 #include <map>
 #include <mutex>

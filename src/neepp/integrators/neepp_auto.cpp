@@ -5,11 +5,11 @@
 #include <optional>
 #include <fmt/format.h>
 #include <tbb/parallel_for.h>
+#include "neepp/base/stats.h"
 #include "neepp/integrators/path.h"
-#include "neepp/render/stats.h"
 #include "neepp/sampling/sampler.h"
-#include "neepp/visibility/neepp_shadow_rays.h"
 #include "neepp/scene/scene.h"
+#include "neepp/visibility/neepp_shadow_rays.h"
 
 namespace neepp {
 

@@ -11,7 +11,7 @@
 #include <memory>
 #include <string>
 #include <vector>
-#include "neepp/integrators/integrator.h"
+#include "neepp/base/integrator.h"
 
 namespace neepp {
 

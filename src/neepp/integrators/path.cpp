@@ -5,9 +5,9 @@
 #include <memory>
 #include <vector>
 
-#include "neepp/light_selection/factory.h"
+#include "neepp/base/bsdf.h"
 #include "neepp/integrators/path_batch.h"
-#include "neepp/materials/bsdf.h"
+#include "neepp/light_selection/factory.h"
 #include "neepp/math/warp.h"
 #include "neepp/sampling/sampler.h"
 #include "neepp/scene/scene.h"
@@ -160,7 +160,7 @@ Color PathIntegrator::sample_direct(const Scene &scene, const SurfaceInteraction
     q.from = si.p;
     q.to = y.ds.p;
     q.unoccluded = M > 1 ? beta * f * y.Le * (w_mis * W) : beta * f * y.Le * (w_mis / light_pdf);
-    return q.unoccluded * queries_->visibility(scene, q, sampler, counters);
+    return q.unoccluded * test_visibility(*queries_, scene, q, sampler, counters);
 }
 
 Color PathIntegrator::Li(const Scene &scene, const Ray &camera_ray, Sampler &sampler, RenderCounters &counters) const {

@@ -4,10 +4,10 @@
 // "Path" baseline (BSDF sampling only, lights found by chance).
 #pragma once
 #include <memory>
-#include "neepp/integrators/integrator.h"
+#include "neepp/base/integrator.h"
+#include "neepp/base/light_sampler.h"
 #include "neepp/light_selection/resampling.h"
 #include "neepp/light_selection/within_light_sampling.h"
-#include "neepp/lights/light_sampler.h"
 #include "neepp/visibility/shadow_ray_tester.h"
 
 namespace neepp {

@@ -5,8 +5,8 @@
 #include <memory>
 #include <vector>
 
+#include "neepp/base/bsdf.h"
 #include "neepp/lights/light_lanes.h"
-#include "neepp/materials/bsdf.h"
 #include "neepp/math/warp.h"
 #include "neepp/sampling/sampler.h"
 #include "neepp/scene/scene.h"

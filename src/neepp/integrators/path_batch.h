@@ -7,8 +7,8 @@
 // test_path_forms.cpp holds the two forms together.
 #pragma once
 #include <span>
+#include "neepp/base/ray_batch.h"
 #include "neepp/integrators/path.h"
-#include "neepp/integrators/ray_batch.h"
 
 namespace neepp {
 

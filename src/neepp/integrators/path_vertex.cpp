@@ -1,6 +1,6 @@
 #include "neepp/integrators/path_vertex.h"
 
-#include "neepp/lights/light.h"
+#include "neepp/base/light.h"
 #include "neepp/sampling/sampler.h"
 #include "neepp/scene/scene.h"
 

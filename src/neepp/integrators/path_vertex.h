@@ -4,10 +4,10 @@
 // (pdf_rev); vertices on infinite lights keep solid-angle densities instead, since they are directions.
 #pragma once
 #include <vector>
-#include "neepp/lights/light_sampler.h"
-#include "neepp/materials/bsdf.h"
-#include "neepp/render/stats.h"
-#include "neepp/scene/interaction.h"
+#include "neepp/base/bsdf.h"
+#include "neepp/base/interaction.h"
+#include "neepp/base/light_sampler.h"
+#include "neepp/base/stats.h"
 
 namespace neepp {
 

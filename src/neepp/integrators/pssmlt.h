@@ -23,7 +23,7 @@
 #pragma once
 #include <memory>
 #include <vector>
-#include "neepp/integrators/integrator.h"
+#include "neepp/base/integrator.h"
 #include "neepp/sampling/primary_sample_space.h"
 
 namespace neepp {

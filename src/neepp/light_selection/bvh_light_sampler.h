@@ -7,7 +7,7 @@
 #pragma once
 #include <cstdint>
 #include <vector>
-#include "neepp/lights/light_sampler.h"
+#include "neepp/base/light_sampler.h"
 
 namespace neepp {
 

@@ -4,7 +4,7 @@
 #include <memory>
 #include <string>
 #include <vector>
-#include "neepp/lights/light_sampler.h"
+#include "neepp/base/light_sampler.h"
 
 namespace neepp {
 

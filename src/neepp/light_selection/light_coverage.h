@@ -4,7 +4,7 @@
 // area for area lights, luminance for environment maps (whose cells are the grid's direction bins).
 #pragma once
 #include <vector>
-#include "neepp/lights/light.h"
+#include "neepp/base/light.h"
 #include "neepp/visibility/visibility_map.h"
 #include "neepp/visibility/voxel_grid.h"
 

@@ -21,7 +21,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
-#include "neepp/lights/light.h"
+#include "neepp/base/light.h"
 #include "neepp/visibility/visibility_map.h"
 #include "neepp/visibility/voxel_grid.h"
 

@@ -6,8 +6,8 @@
 #pragma once
 #include <functional>
 #include <vector>
+#include "neepp/light_selection/basic_light_samplers.h"
 #include "neepp/light_selection/lazy_voxel_array.h"
-#include "neepp/lights/light_sampler.h"
 
 namespace neepp {
 

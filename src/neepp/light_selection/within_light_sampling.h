@@ -8,7 +8,7 @@
 #include <string>
 #include <vector>
 #include <nlohmann/json.hpp>
-#include "neepp/lights/light_sampler.h"
+#include "neepp/base/light_sampler.h"
 
 namespace neepp {
 

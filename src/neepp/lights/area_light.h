@@ -2,9 +2,9 @@
 // the side its shading normal faces: on a mesh with vertex normals, a point near the silhouette whose
 // interpolated normal has turned away from the viewer does not emit toward it, though its face does.
 #pragma once
-#include "neepp/lights/light.h"
+#include "neepp/base/light.h"
+#include "neepp/base/texture.h"
 #include "neepp/lights/light_lanes.h"
-#include "neepp/materials/texture.h"
 #include "neepp/scene/shape.h"
 
 namespace neepp {

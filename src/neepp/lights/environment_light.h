@@ -5,8 +5,8 @@
 #include <cmath>
 #include <cstdint>
 #include <vector>
+#include "neepp/base/light.h"
 #include "neepp/io/image.h"
-#include "neepp/lights/light.h"
 #include "neepp/math/distribution.h"
 #include "neepp/math/transform.h"
 

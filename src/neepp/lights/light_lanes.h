@@ -8,7 +8,7 @@
 #pragma once
 #include <cstddef>
 
-#include "neepp/lights/light.h"
+#include "neepp/base/light.h"
 
 namespace neepp {
 

@@ -5,8 +5,8 @@
 // the axis is pi scale E(uv) / cos^3 theta, so a constant texture lights a plane facing the projector
 // evenly. Emitted rays leave uniformly over the image plane.
 #pragma once
-#include "neepp/lights/light.h"
-#include "neepp/materials/texture.h"
+#include "neepp/base/light.h"
+#include "neepp/base/texture.h"
 #include "neepp/scene/camera.h"
 
 namespace neepp {

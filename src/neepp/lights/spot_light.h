@@ -5,8 +5,8 @@
 // (x, y, z) looks up uv = 0.5 + 0.5 (x, y) / (z tan cutoff_angle), so the texture's square spans the
 // cutoff cone's tangent plane at z = 1. Emitted rays still fill the cone uniformly, as Mitsuba's do.
 #pragma once
-#include "neepp/lights/light.h"
-#include "neepp/materials/texture.h"
+#include "neepp/base/light.h"
+#include "neepp/base/texture.h"
 #include "neepp/math/transform.h"
 
 namespace neepp {

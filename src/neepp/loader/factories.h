@@ -3,8 +3,8 @@
 #pragma once
 #include <map>
 #include <memory>
+#include "neepp/base/bsdf.h"
 #include "neepp/io/xml_tree.h"
-#include "neepp/materials/bsdf.h"
 #include "neepp/materials/hair.h"
 #include "neepp/materials/principled.h"
 #include "neepp/materials/principledthin.h"

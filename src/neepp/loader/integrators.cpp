@@ -1,7 +1,7 @@
 #include <algorithm>
 #include <set>
 #include <fmt/core.h>
-#include "neepp/integrators/integrator.h"
+#include "neepp/integrators/factory.h"
 #include "neepp/loader/factories.h"
 #include "neepp/loader/supported_plugins.h"
 

@@ -5,10 +5,10 @@
 #include <functional>
 #include <string>
 #include <vector>
+#include "neepp/base/bsdf.h"
+#include "neepp/base/light.h"
 #include "neepp/io/mesh_data.h"
 #include "neepp/io/xml_tree.h"
-#include "neepp/lights/light.h"
-#include "neepp/materials/bsdf.h"
 
 namespace neepp {
 

@@ -7,8 +7,8 @@
 #include <string_view>
 #include <vector>
 
+#include "neepp/base/texture.h"
 #include "neepp/io/image.h"
-#include "neepp/materials/texture.h"
 #include "neepp/math/transform.h"
 
 namespace neepp {

@@ -3,7 +3,7 @@
 // direction from a smooth lobe then gets the blend's own density, the two pdfs weighted alike, so that its
 // weight is the blended eval over it.
 #pragma once
-#include "neepp/materials/bsdf.h"
+#include "neepp/base/bsdf.h"
 
 namespace neepp {
 

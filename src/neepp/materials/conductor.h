@@ -7,7 +7,7 @@
 //   k                     texture 1.0     imaginary part (absorption)
 //   specular_reflectance  texture 1.0     multiplier (not physical)
 #pragma once
-#include "neepp/materials/bsdf.h"
+#include "neepp/base/bsdf.h"
 
 namespace neepp {
 

@@ -1,6 +1,6 @@
 // Lambertian reflector (Mitsuba's `diffuse`): one-sided, black when seen from below.
 #pragma once
-#include "neepp/materials/bsdf.h"
+#include "neepp/base/bsdf.h"
 #include "neepp/math/warp.h"
 
 namespace neepp {

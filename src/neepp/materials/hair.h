@@ -29,7 +29,7 @@
 #pragma once
 #include <utility>
 
-#include "neepp/materials/bsdf.h"
+#include "neepp/base/bsdf.h"
 
 namespace neepp {
 

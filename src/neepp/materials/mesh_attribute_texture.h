@@ -4,7 +4,7 @@
 // r, g, b properties).
 #pragma once
 #include <string>
-#include "neepp/materials/texture.h"
+#include "neepp/base/texture.h"
 
 namespace neepp {
 

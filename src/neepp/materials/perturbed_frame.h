@@ -3,7 +3,7 @@
 // once: Mitsuba 3's two defaults, `flip_invalid_normals` and `use_shadowing_function`, the side test of
 // the direction toward the light, and the correction that light tracing and BDPT need for the frame.
 #pragma once
-#include "neepp/materials/bsdf.h"
+#include "neepp/base/bsdf.h"
 
 namespace neepp {
 

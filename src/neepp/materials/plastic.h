@@ -9,7 +9,7 @@
 //   specular_reflectance  texture 1.0    multiplier on the coating reflection (not physical)
 //   nonlinear             bool    false  account for the base's color shift from internal scattering
 #pragma once
-#include "neepp/materials/bsdf.h"
+#include "neepp/base/bsdf.h"
 
 namespace neepp {
 

@@ -14,9 +14,9 @@
 //   sample_visible        bool    true
 //   eta | int_ior, ext_ior  float  polypropylene / air
 #pragma once
-#include "neepp/materials/bsdf.h"
+#include "neepp/base/bsdf.h"
+#include "neepp/base/texture.h"
 #include "neepp/materials/microfacet.h"
-#include "neepp/materials/texture.h"
 
 namespace neepp {
 

@@ -26,7 +26,7 @@
 //   main_specular_sampling_rate, clearcoat_sampling_rate, diffuse_reflectance_sampling_rate   float  1.0
 #pragma once
 #include <cmath>
-#include "neepp/materials/bsdf.h"
+#include "neepp/base/bsdf.h"
 #include "neepp/materials/microfacet.h"
 
 namespace neepp {

@@ -23,7 +23,7 @@
 //   specular_reflectance_sampling_rate, specular_transmittance_sampling_rate,
 //   diffuse_reflectance_sampling_rate, diffuse_transmittance_sampling_rate   float  1.0
 #pragma once
-#include "neepp/materials/bsdf.h"
+#include "neepp/base/bsdf.h"
 #include "neepp/materials/microfacet.h"
 
 namespace neepp {

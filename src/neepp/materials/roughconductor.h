@@ -9,7 +9,7 @@
 //   sample_visible        bool    true        sample the distribution of visible normals
 //   specular_reflectance  texture 1.0         multiplier (not physical)
 #pragma once
-#include "neepp/materials/bsdf.h"
+#include "neepp/base/bsdf.h"
 #include "neepp/materials/microfacet.h"
 
 namespace neepp {

@@ -19,7 +19,7 @@
 //   specular_reflectance    texture  1.0         multiplier (not physical)
 //   specular_transmittance  texture  1.0         multiplier (not physical)
 #pragma once
-#include "neepp/materials/bsdf.h"
+#include "neepp/base/bsdf.h"
 #include "neepp/materials/microfacet.h"
 
 namespace neepp {

@@ -14,7 +14,7 @@
 //   nonlinear             bool    false
 #pragma once
 #include <array>
-#include "neepp/materials/bsdf.h"
+#include "neepp/base/bsdf.h"
 #include "neepp/materials/microfacet.h"
 
 namespace neepp {

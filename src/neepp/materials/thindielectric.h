@@ -9,7 +9,7 @@
 //   specular_reflectance    texture 1.0
 //   specular_transmittance  texture 1.0
 #pragma once
-#include "neepp/materials/bsdf.h"
+#include "neepp/base/bsdf.h"
 
 namespace neepp {
 

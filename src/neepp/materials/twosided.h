@@ -1,7 +1,7 @@
 // Mitsuba's `twosided`: makes a one-sided BSDF (or a pair, front and back) reflect on both sides by
 // mirroring directions seen from below into the upper hemisphere.
 #pragma once
-#include "neepp/materials/bsdf.h"
+#include "neepp/base/bsdf.h"
 
 namespace neepp {
 

@@ -6,7 +6,7 @@
 #include <cstdint>
 #include <string>
 #include <vector>
-#include "neepp/render/stats.h"
+#include "neepp/base/stats.h"
 
 namespace neepp {
 

@@ -8,12 +8,12 @@
 #include <tbb/global_control.h>
 #include <tbb/parallel_for.h>
 #include <tbb/task_arena.h>
-#include "neepp/integrators/integrator.h"
+#include "neepp/base/integrator.h"
+#include "neepp/base/stats.h"
 #include "neepp/math/denormals.h"
 #include "neepp/render/film.h"
 #include "neepp/render/memory.h"
 #include "neepp/render/progress_bar.h"
-#include "neepp/render/stats.h"
 #include "neepp/sampling/sampler.h"
 #include "neepp/scene/scene.h"
 

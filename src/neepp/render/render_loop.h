@@ -6,10 +6,10 @@
 #include <atomic>
 #include <functional>
 #include <string>
+#include "neepp/base/stats.h"
 #include "neepp/io/image.h"
 #include "neepp/render/checkpoint.h"
 #include "neepp/render/progress_bar.h"
-#include "neepp/render/stats.h"
 
 namespace neepp {
 

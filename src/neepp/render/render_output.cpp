@@ -4,7 +4,7 @@
 #include <fstream>
 #include <string>
 #include <sys/resource.h>
-#include "neepp/integrators/integrator.h"
+#include "neepp/base/integrator.h"
 #include "neepp/render/huge_pages.h"
 #include "neepp/scene/scene.h"
 

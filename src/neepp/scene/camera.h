@@ -4,8 +4,8 @@
 // the top-left to (1,1) bottom-right.
 #pragma once
 #include <string>
+#include "neepp/base/interaction.h"
 #include "neepp/math/transform.h"
-#include "neepp/scene/interaction.h"
 
 namespace neepp {
 

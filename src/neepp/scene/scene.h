@@ -5,7 +5,7 @@
 #include <string>
 #include <vector>
 #include <embree3/rtcore.h>
-#include "neepp/lights/light.h"
+#include "neepp/base/light.h"
 #include "neepp/scene/camera.h"
 #include "neepp/scene/shape.h"
 

@@ -5,13 +5,13 @@
 #include <optional>
 #include <string>
 #include <vector>
+#include "neepp/base/bsdf.h"
+#include "neepp/base/interaction.h"
 #include "neepp/io/mesh_data.h"
-#include "neepp/materials/bsdf.h"
 #include "neepp/math/bbox.h"
 #include "neepp/math/distribution.h"
 #include "neepp/math/transform.h"
 #include "neepp/scene/curve.h"
-#include "neepp/scene/interaction.h"
 
 namespace neepp {
 

@@ -21,12 +21,12 @@ void trace_shadow_rays16(const Scene &scene, const Ray *const *rays, int n, bool
     for (int i = 0; i < n; ++i) counters.shadow_rays_occluded += occluded[i];
 }
 
-float ShadowRayTester::visibility(const Scene &scene, const ShadowQuery &q, Sampler &sampler,
-                                  RenderCounters &counters) const {
-    const ShadowTest test = begin_test(q, sampler, counters);
+float test_visibility(const ShadowRayTester &tester, const Scene &scene, const ShadowQuery &q, Sampler &sampler,
+                      RenderCounters &counters) {
+    const ShadowTest test = tester.begin_test(q, sampler, counters);
     if (!test.trace) return test.if_skipped;
     const bool occluded = trace_shadow_ray(scene, q.ray, counters);
-    end_test(test, occluded);
+    tester.end_test(test, occluded);
     return test.weight(occluded);
 }
 

@@ -1,4 +1,4 @@
-#include "neepp/integrators/options.h"
+#include "neepp/base/options.h"
 
 #include <stdexcept>
 

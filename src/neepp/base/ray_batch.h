@@ -4,8 +4,8 @@
 // compute what Li computes, path by path, and be tested against it (tests/integrators/test_path_forms.cpp).
 #pragma once
 #include <span>
-#include "neepp/render/stats.h"
-#include "neepp/scene/interaction.h"
+#include "neepp/base/interaction.h"
+#include "neepp/base/stats.h"
 
 namespace neepp {
 

@@ -1,4 +1,4 @@
-#include "neepp/lights/light_sampler.h"
+#include "neepp/light_selection/basic_light_samplers.h"
 
 namespace neepp {
 

@@ -4,9 +4,9 @@
 #include <cstdint>
 #include <memory>
 #include <optional>
-#include "neepp/lights/light_bounds.h"
+#include "neepp/base/interaction.h"
+#include "neepp/base/light_bounds.h"
 #include "neepp/math/bbox.h"
-#include "neepp/scene/interaction.h"
 
 namespace neepp {
 

@@ -1,7 +1,7 @@
-#include "neepp/integrators/integrator.h"
+#include "neepp/base/integrator.h"
 
 #include <stdexcept>
-#include "neepp/integrators/ray_batch.h"
+#include "neepp/base/ray_batch.h"
 
 namespace neepp {
 

@@ -1,7 +1,7 @@
 // Textures: spatially varying RGB or scalar parameters of BSDFs, looked up by surface uv.
 #pragma once
 #include <memory>
-#include "neepp/scene/interaction.h"
+#include "neepp/base/interaction.h"
 
 namespace neepp {
 

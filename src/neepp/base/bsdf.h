@@ -9,8 +9,8 @@
 #pragma once
 #include <cstdint>
 #include <memory>
-#include "neepp/materials/texture.h"
-#include "neepp/scene/interaction.h"
+#include "neepp/base/interaction.h"
+#include "neepp/base/texture.h"
 
 namespace neepp {
 

@@ -1,4 +1,4 @@
-#include "neepp/render/stats.h"
+#include "neepp/base/stats.h"
 
 #include <time.h>
 #include <chrono>

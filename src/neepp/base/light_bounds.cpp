@@ -1,4 +1,4 @@
-#include "neepp/lights/light_bounds.h"
+#include "neepp/base/light_bounds.h"
 
 #include <algorithm>
 #include <cmath>
