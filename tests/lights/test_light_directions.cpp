@@ -9,7 +9,7 @@
 #include "common/chi2.h"
 #include "neepp/lights/area_light.h"
 #include "neepp/lights/environment_light.h"
-#include "neepp/materials/checkerboard_texture.h"
+#include "neepp/textures/checkerboard_texture.h"
 #include "neepp/math/warp.h"
 
 namespace neepp::test {

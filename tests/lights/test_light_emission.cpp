@@ -9,7 +9,7 @@
 #include "neepp/lights/environment_light.h"
 #include "neepp/lights/projector_light.h"
 #include "neepp/lights/spot_light.h"
-#include "neepp/materials/bitmap_texture.h"
+#include "neepp/textures/bitmap_texture.h"
 #include "neepp/math/frame.h"
 #include "neepp/sampling/rng.h"
 

@@ -7,7 +7,7 @@
 
 #include "neepp/lights/area_light.h"
 #include "neepp/lights/light_lanes.h"
-#include "neepp/materials/checkerboard_texture.h"
+#include "neepp/textures/checkerboard_texture.h"
 
 namespace neepp::test {
 namespace {

@@ -2,7 +2,7 @@
 #include <gtest/gtest.h>
 #include "neepp/io/scene_error.h"
 #include "neepp/loader/factories.h"
-#include "neepp/materials/mesh_attribute_texture.h"
+#include "neepp/textures/mesh_attribute_texture.h"
 #include <filesystem>
 #include <fstream>
 #include "test_scenes.h"

@@ -14,6 +14,8 @@
 #include "neepp/materials/roughplastic.h"
 #include "neepp/materials/thindielectric.h"
 #include "neepp/materials/bumpmap.h"
+#include "neepp/materials/mask.h"
+#include "neepp/materials/null.h"
 #include "neepp/materials/twosided.h"
 #include "neepp/sampling/rng.h"
 

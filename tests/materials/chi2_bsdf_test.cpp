@@ -8,7 +8,7 @@
 
 #include "chi2.h"
 #include "neepp/materials/blendbsdf.h"
-#include "neepp/materials/checkerboard_texture.h"
+#include "neepp/textures/checkerboard_texture.h"
 #include "neepp/materials/conductor.h"
 #include "neepp/materials/diffuse.h"
 #include "neepp/materials/normalmap.h"

@@ -6,6 +6,8 @@
 #include "neepp/materials/diffuse.h"
 #include "neepp/materials/roughconductor.h"
 #include "neepp/materials/bumpmap.h"
+#include "neepp/materials/mask.h"
+#include "neepp/materials/null.h"
 #include "neepp/materials/twosided.h"
 #include "neepp/sampling/rng.h"
 #include "neepp/scene/shape.h"

@@ -19,6 +19,8 @@
 #include "neepp/materials/pplastic.h"
 #include "neepp/materials/roughplastic.h"
 #include "neepp/materials/thindielectric.h"
+#include "neepp/materials/mask.h"
+#include "neepp/materials/null.h"
 #include "neepp/materials/twosided.h"
 
 namespace neepp::loader {

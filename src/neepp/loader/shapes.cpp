@@ -15,7 +15,7 @@
 #include "neepp/loader/factories.h"
 #include "neepp/loader/plugins.h"
 #include "neepp/loader/problems.h"
-#include "neepp/materials/bitmap_texture.h"
+#include "neepp/textures/bitmap_texture.h"
 #include "neepp/scene/sdf_grid.h"
 
 namespace neepp::loader {

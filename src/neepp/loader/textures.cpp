@@ -3,9 +3,9 @@
 #include "neepp/loader/factories.h"
 #include "neepp/loader/plugins.h"
 #include "neepp/loader/problems.h"
-#include "neepp/materials/bitmap_texture.h"
-#include "neepp/materials/checkerboard_texture.h"
-#include "neepp/materials/mesh_attribute_texture.h"
+#include "neepp/textures/bitmap_texture.h"
+#include "neepp/textures/checkerboard_texture.h"
+#include "neepp/textures/mesh_attribute_texture.h"
 
 namespace neepp::loader {
 

@@ -1,4 +1,4 @@
-#include "neepp/materials/bitmap_texture.h"
+#include "neepp/textures/bitmap_texture.h"
 
 #include <array>
 #include <cmath>

@@ -4,8 +4,8 @@
 #include <filesystem>
 #include <stdexcept>
 
-#include "neepp/materials/bitmap_texture.h"
-#include "neepp/materials/checkerboard_texture.h"
+#include "neepp/textures/bitmap_texture.h"
+#include "neepp/textures/checkerboard_texture.h"
 #include "common/temp_dir.h"
 
 using namespace neepp;

@@ -1,4 +1,4 @@
-#include "neepp/materials/checkerboard_texture.h"
+#include "neepp/textures/checkerboard_texture.h"
 
 #include <cmath>
 

@@ -1,7 +1,7 @@
 // Mitsuba 3's procedural `checkerboard` texture.
 #pragma once
 #include "neepp/base/texture.h"
-#include "neepp/materials/bitmap_texture.h"  // UvTransform
+#include "neepp/textures/bitmap_texture.h"  // UvTransform
 
 namespace neepp {
 

@@ -1,4 +1,4 @@
-#include "neepp/materials/mesh_attribute_texture.h"
+#include "neepp/textures/mesh_attribute_texture.h"
 
 #include <stdexcept>
 #include "neepp/scene/shape.h"
