@@ -11,6 +11,7 @@
 namespace neepp {
 
 struct LightLaneRecord;
+class LightSampleSteps;
 
 // A point on a light as seen from a reference point: where, which way, how likely.
 struct DirectionSample {
@@ -21,14 +22,6 @@ struct DirectionSample {
     float dist = 0;      // distance to p (infinite for environment lights)
     float pdf = 0;       // solid-angle density at the reference point (1 for delta lights)
     bool delta = false;  // sampled from a delta distribution (point light): not reachable by BSDF sampling
-};
-
-// A light sample begun by Light::begin_sample, for finish_sample: its variates, and what the light
-// computed from them alone (an environment map: the map point and its density in uv).
-struct LightSampleStart {
-    Vec2 u;
-    Vec2 point{0.f, 0.f};
-    float density = 0;
 };
 
 // A ray leaving a light, for light paths (light tracing, BDPT): where it starts, which way, how likely.
@@ -58,16 +51,6 @@ public:
     // Samples a direction toward the light from ref. Returns the emitted radiance arriving at ref along
     // -d, ignoring occlusion, via `radiance` (zero when the sample is invalid, e.g. the back of an area light).
     virtual DirectionSample sample_direction(const Vec3 &ref, Vec2 u, Color &radiance) const = 0;
-    // Light samples in steps, for batched integrators, which take each step for many paths before the
-    // next (a light sample is otherwise a chain of cache misses):
-    //   prefetch_sample(u)            cache prefetch of what u alone locates (a hint; never changes a result);
-    //   begin_sample(u)               the work u alone determines, and a prefetch of what finishing reads;
-    //   finish_sample(ref, start)     the rest: finish_sample(ref, begin_sample(u)) is sample_direction(ref, u).
-    virtual void prefetch_sample(Vec2 u) const {}
-    virtual LightSampleStart begin_sample(Vec2 u) const { return {u}; }
-    virtual DirectionSample finish_sample(const Vec3 &ref, const LightSampleStart &start, Color &radiance) const {
-        return sample_direction(ref, start.u, radiance);
-    }
     // Solid-angle density with which sample_direction would have produced ds from ref (0 for delta lights).
     virtual float pdf_direction(const Vec3 &ref, const DirectionSample &ds) const = 0;
     // An emitted ray from two pairs of variates, u_pos for the origin and u_dir for the direction.
@@ -90,6 +73,10 @@ public:
     // Where and which way the light emits, for the light BVH; none for infinite lights (sampled apart).
     virtual std::optional<LightBounds> bounds() const { return std::nullopt; }
 
+    // Speed hooks, for the fast forms of integrators; a light that offers neither is sampled by
+    // sample_direction, slower, the same in expectation.
+    // Its samples in steps (base/light_steps.h), or null.
+    virtual const LightSampleSteps *steps() const { return nullptr; }
     // For lights that integrators may sample in lanes (LightSampleLanes, light_lanes.h) with the same
     // distribution as sample_direction: what the lane kernel reads. Null: sample_direction only.
     const LightLaneRecord *lane_record() const { return lane_record_; }

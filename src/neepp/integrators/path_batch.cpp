@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "neepp/base/bsdf.h"
+#include "neepp/base/light_steps.h"
 #include "neepp/lights/light_lanes.h"
 #include "neepp/math/warp.h"
 #include "neepp/sampling/sampler.h"
@@ -17,6 +18,7 @@ struct PathBatch::Candidate {
     SampledLight light;
     const ContextLightSampler *within = nullptr;  // samples points of the light, if not the light itself
     LightSampleStart start;  // begun by begin_light, from the light's variates
+    const LightSampleSteps *steps = nullptr;  // the light's samples in steps, if it offers them
     LightSample sample;      // taken by sample_light, alone or in lanes
     // Resampling only: the BSDF toward the sample, the cell of its light point, its target p̂.
     BSDFEval bsdf;
@@ -120,8 +122,9 @@ bool PathBatch::begin_vertex(const Scene &scene, Path &path) const {
     for (int i = 0; i < M; ++i) {
         Candidate &c = path.candidates[i];
         c.within = c.light.light ? pi.within_light_.for_light(*c.light.light) : nullptr;
+        c.steps = c.light.light && !c.within ? c.light.light->steps() : nullptr;
         if (c.within) c.within->prefetch(path.ctx, c.start.u);
-        else if (c.light.light) c.light.light->prefetch_sample(c.start.u);
+        else if (c.steps) c.steps->prefetch(c.start.u);
     }
     return true;
 }
@@ -131,7 +134,9 @@ void PathBatch::begin_light(Path &path) const {
     for (int i = 0; i < path.m; ++i) {
         Candidate &c = path.candidates[i];
         if (!c.light.light) continue;
-        c.start = c.within ? c.within->begin(path.ctx, c.start.u) : c.light.light->begin_sample(c.start.u);
+        c.start = c.within ? c.within->begin(path.ctx, c.start.u)
+                  : c.steps  ? c.steps->begin(c.start.u)
+                             : LightSampleStart{c.start.u};
     }
 }
 
@@ -150,8 +155,10 @@ void PathBatch::sample_light(Path &path, LightSampleLanes &lanes) const {
             c.sample.ds = c.within->finish(path.ctx, c.start, c.sample.radiance);
         else if (const LightLaneRecord *record = sl.light->lane_record())
             lanes.add(*record, path.si.p, c.start.u, c.sample);
+        else if (c.steps)
+            c.sample.ds = c.steps->finish(path.si.p, c.start, c.sample.radiance);
         else
-            c.sample.ds = sl.light->finish_sample(path.si.p, c.start, c.sample.radiance);
+            c.sample.ds = sl.light->sample_direction(path.si.p, c.start.u, c.sample.radiance);
     }
     path.nee = any;
 }

@@ -27,12 +27,12 @@ private:
     // event estimation; it and finish_vertex return false when the path ends.
     bool begin_vertex(const Scene &scene, Path &path) const;
     // Next event estimation at the vertex: begin_light and sample_light sample the light chosen at
-    // begin_vertex in two steps (Light::begin_sample, finish_sample), the second eight at a time where the
-    // light allows it (LightSampleLanes: a rectangle of constant radiance); with resampling (ris > 1) that
-    // is done for each candidate, weigh_candidates evaluates the BSDF toward each and prefetches its map
-    // entry, and resample reads the entries and chooses one; begin_direct forms the shadow query (false:
-    // it contributes nothing); decide_direct asks the shadow-ray policy and returns true when a ray must
-    // be traced, whose outcome end_direct takes.
+    // begin_vertex in two steps where the light offers them (LightSampleSteps: begin, finish), and eight at
+    // a time where it allows (LightSampleLanes: a rectangle of constant radiance); with resampling (ris > 1)
+    // that is done for each candidate, weigh_candidates evaluates the BSDF toward each and prefetches its
+    // map entry, and resample reads the entries and chooses one; begin_direct forms the shadow query
+    // (false: it contributes nothing); decide_direct asks the shadow-ray policy and returns true when a ray
+    // must be traced, whose outcome end_direct takes.
     void begin_light(Path &path) const;
     void sample_light(Path &path, LightSampleLanes &lanes) const;
     void weigh_candidates(Path &path) const;

@@ -33,6 +33,9 @@ SampledLight LightDistribution::sample(const std::vector<const Light *> &lights,
     return {l, pmf(*l)};
 }
 
+// Defined here, beside LightDistribution::sample, so that it is inlined into the one copy of this.
+SampledLight PowerLightSampler::sample(const LightSampleContext &, float u) const { return distribution_.sample(lights_, u); }
+
 PowerLightSampler::PowerLightSampler(std::vector<const Light *> lights)
     : lights_(std::move(lights)), distribution_(lights_, power_fractions(lights_)) {}
 

@@ -47,7 +47,7 @@ private:
 class PowerLightSampler final : public LightSampler {
 public:
     explicit PowerLightSampler(std::vector<const Light *> lights);
-    SampledLight sample(const LightSampleContext &, float u) const override { return distribution_.sample(lights_, u); }
+    SampledLight sample(const LightSampleContext &, float u) const override;
     float pmf(const LightSampleContext &, const Light &light) const override { return distribution_.pmf(light); }
     std::string name() const override { return "power"; }
 

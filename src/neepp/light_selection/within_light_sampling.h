@@ -9,6 +9,7 @@
 #include <vector>
 #include <nlohmann/json.hpp>
 #include "neepp/base/light_sampler.h"
+#include "neepp/base/light_steps.h"
 
 namespace neepp {
 

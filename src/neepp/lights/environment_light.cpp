@@ -190,7 +190,7 @@ Vec2 EnvironmentMapLight::sample_uv(Vec2 u, float &pdf_uv) const {
     return {(float(cell % w) + offset.x) / float(w), (float(cell / w) + offset.y) / float(h)};
 }
 
-LightSampleStart EnvironmentMapLight::begin_sample(Vec2 u) const {
+LightSampleStart EnvironmentMapLight::begin(Vec2 u) const {
     LightSampleStart start{u};
     start.point = sample_uv(u, start.density);
     prefetch_lookup(start.point);
@@ -198,7 +198,7 @@ LightSampleStart EnvironmentMapLight::begin_sample(Vec2 u) const {
 }
 
 void EnvironmentMapLight::prefetch_lookup(Vec2 uv) const {
-    // lookup(uv)'s bilinear footprint, which finish_sample reads: in each of its two texel rows, the first
+    // lookup(uv)'s bilinear footprint, which finish reads: in each of its two texel rows, the first
     // and the last byte loaded (two texels and a half, 14 bytes, cross a cache line one time in five, and
     // with the first line only prefetched, misses on the second are a large part of lookup's time).
     const int x = std::min(int(uv.x * float(width_)), width_ - 1);
@@ -211,7 +211,7 @@ void EnvironmentMapLight::prefetch_lookup(Vec2 uv) const {
     }
 }
 
-DirectionSample EnvironmentMapLight::finish_sample(const Vec3 &ref, const LightSampleStart &start,
+DirectionSample EnvironmentMapLight::finish(const Vec3 &ref, const LightSampleStart &start,
                                                    Color &radiance) const {
     return direction_from_uv(ref, start.point, start.density, radiance);
 }
@@ -232,7 +232,7 @@ DirectionSample EnvironmentMapLight::direction_from_uv(const Vec3 &ref, Vec2 uv,
 }
 
 DirectionSample EnvironmentMapLight::sample_direction(const Vec3 &ref, Vec2 u, Color &radiance) const {
-    return finish_sample(ref, begin_sample(u), radiance);
+    return finish(ref, begin(u), radiance);
 }
 
 float EnvironmentMapLight::pdf_direction(const Vec3 &, const DirectionSample &ds) const {

@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <vector>
 #include "neepp/base/light.h"
+#include "neepp/base/light_steps.h"
 #include "neepp/io/image.h"
 #include "neepp/math/distribution.h"
 #include "neepp/math/transform.h"
@@ -24,15 +25,16 @@ struct SceneSphere {
     Ray disk_ray(const Vec3 &d, Vec2 u) const;
 };
 
-class EnvironmentMapLight final : public Light {
+class EnvironmentMapLight final : public Light, public LightSampleSteps {
 public:
     // `image` in linear RGB; `to_world` orients the map (Mitsuba: +y is the map's up, u = 0 faces -z).
     EnvironmentMapLight(Image image, const Transform &to_world, float scale);
     DirectionSample sample_direction(const Vec3 &ref, Vec2 u, Color &radiance) const override;
     float pdf_direction(const Vec3 &ref, const DirectionSample &ds) const override;
-    void prefetch_sample(Vec2 u) const override { cells_.prefetch(u); }
-    LightSampleStart begin_sample(Vec2 u) const override;
-    DirectionSample finish_sample(const Vec3 &ref, const LightSampleStart &start, Color &radiance) const override;
+    const LightSampleSteps *steps() const override { return this; }
+    void prefetch(Vec2 u) const override { cells_.prefetch(u); }
+    LightSampleStart begin(Vec2 u) const override;
+    DirectionSample finish(const Vec3 &ref, const LightSampleStart &start, Color &radiance) const override;
     Color eval_environment(const Vec3 &d) const override;
     EmissionSample sample_emission(Vec2 u_pos, Vec2 u_dir) const override;
     EmissionDensity pdf_emission(const Vec3 &, const Vec3 &, const Vec3 &, const Vec3 &w) const override;
