@@ -1,4 +1,4 @@
-// Triangle hits filled 8 at a time (Shape::HitLanes) give the hit records the scalar fill gives
+// Triangle hits filled 8 at a time (HitLanes) give the hit records the scalar fill gives
 // (Scene::fill: fill_interaction, then wi), for every kind of mesh a lane can hold: vertex normals or
 // not, face normals forced, flipped normals, texture coordinates or not, a vertex normal that cancels
 // out, and any number of lanes in use.
@@ -9,6 +9,7 @@
 
 #include "neepp/materials/diffuse.h"
 #include "neepp/sampling/rng.h"
+#include "neepp/scene/hit_lanes.h"
 #include "neepp/scene/shape.h"
 
 using namespace neepp;
@@ -72,10 +73,10 @@ TEST(FillLanes, SameRecordsAsOneAtATime) {
     for (const auto &s : shapes) ASSERT_TRUE(s->fills_in_lanes());
     PCG32 rng(5, 9);
     for (int round = 0; round < 400; ++round) {
-        const int n = 1 + round % Shape::kHitLanes;  // every lane count
-        Hit hits[Shape::kHitLanes];
-        SurfaceInteraction out[Shape::kHitLanes];
-        Shape::HitLanes lanes;
+        const int n = 1 + round % HitLanes::kLanes;  // every lane count
+        Hit hits[HitLanes::kLanes];
+        SurfaceInteraction out[HitLanes::kLanes];
+        HitLanes lanes;
         for (int i = 0; i < n; ++i) {
             Hit &h = hits[i];
             h.shape = shapes[rng.next_u32() % shapes.size()].get();
@@ -86,9 +87,9 @@ TEST(FillLanes, SameRecordsAsOneAtATime) {
             if (round % 7 == 0) h.prim = 0, h.b1 = 0, h.b2 = 0.5f;
             h.t = 0.5f + rng.next_float();
             h.d = normalize(Vec3(rng.next_float() - 0.5f, rng.next_float() - 0.5f, -1.f));
-            h.shape->add_lane(lanes, h.prim, h.b1, h.b2, h.t, h.d, out[i]);
+            add_lane(lanes, *h.shape, h.prim, h.b1, h.b2, h.t, h.d, out[i]);
         }
-        Shape::fill_lanes(lanes);  // (the eighth lane has filled them already)
+        fill_lanes(lanes);  // (the eighth lane has filled them already)
         EXPECT_EQ(lanes.n, 0);
         for (int i = 0; i < n; ++i) expect_same_record(out[i], hits[i]);
     }

@@ -312,12 +312,12 @@ void PathBatch::Li_batch(const Scene &scene, std::span<const Ray> rays, std::spa
                 counters.rays += m;
                 for (int j = 0; j < m; ++j) scene.prefetch(*hs[j]);
             }
-            // The hit records, most of them eight at a time (Shape::HitLanes): the triangles' data, fetched
+            // The hit records, most of them eight at a time (HitLanes): the triangles' data, fetched
             // for the prefetches above, is in cache by now.
-            Shape::HitLanes lanes;
+            HitLanes lanes;
             for (size_t k = 0; k < live; ++k)
                 if (Path &p = paths[active[k]]; p.hit.valid()) scene.fill_in_lanes(lanes, p.hit, p.ray, p.si);
-            Shape::fill_lanes(lanes);
+            fill_lanes(lanes);
             size_t shading = 0;
             for (size_t k = 0; k < live; ++k)
                 if (begin_vertex(scene, paths[active[k]])) active[shading++] = active[k];

@@ -1,5 +1,5 @@
 // Arithmetic on eight lanes of one AVX register (one path per lane), for the lane kernels that shade a
-// batch's paths together (Shape::HitLanes, LightSampleLanes). Names follow the scalar code they mirror,
+// batch's paths together (HitLanes, LightSampleLanes). Names follow the scalar code they mirror,
 // so a kernel reads as its scalar counterpart does.
 #pragma once
 #if defined(__AVX__)

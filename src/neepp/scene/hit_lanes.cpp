@@ -1,4 +1,4 @@
-// Triangle hits filled eight at a time (Shape::HitLanes): the first step of shading in SoA.
+// Triangle hits filled eight at a time (HitLanes): the first step of shading in SoA.
 //
 // Why: filling a hit record (interpolated position, face and vertex normals, uv, shading frame, wi) is
 // scalar arithmetic with two square roots and three divisions per hit, a large share of neepp's own
@@ -7,7 +7,7 @@
 // three rows of 8 floats, and so are the first 24 floats of a hit record.
 #include <cstddef>
 
-#include "neepp/scene/shape.h"
+#include "neepp/scene/hit_lanes.h"
 
 #include "neepp/math/lanes.h"
 #include "neepp/math/transpose.h"
@@ -22,15 +22,15 @@ using namespace lanes;
 // b0 a0 + b1 a1 + b2 a2: one coordinate interpolated across the triangle's corners.
 inline V interpolate(V a0, V a1, V a2, V b0, V b1, V b2) { return mul_add(a0, b0, mul_add(a1, b1, mul(a2, b2))); }
 
-void fill_kernel(Shape::HitLanes &h) {
+void fill_kernel(HitLanes &h) {
     // The layouts the transposes assume: a triangle's record is p[3], n[3], uv[3] (24 floats), and the
     // hit record starts with p, t, n, the shading frame (s, t, n), uv, dp/du, dp/dv, wi.
     static_assert(offsetof(SurfaceInteraction, t) == 12 && offsetof(SurfaceInteraction, n) == 16 &&
                   offsetof(SurfaceInteraction, sh_frame) == 28 && offsetof(SurfaceInteraction, uv) == 64 &&
                   offsetof(SurfaceInteraction, dpdu) == 72 && offsetof(SurfaceInteraction, dpdv) == 84 &&
                   offsetof(SurfaceInteraction, wi) == 96);
-    static_assert(Shape::kHitLanes == 8, "one lane per float of an AVX register");
-    for (int i = h.n; i < Shape::kHitLanes; ++i) {  // unused lanes redo lane 0 (their results are dropped)
+    static_assert(HitLanes::kLanes == 8, "one lane per float of an AVX register");
+    for (int i = h.n; i < HitLanes::kLanes; ++i) {  // unused lanes redo lane 0 (their results are dropped)
         h.tri[i] = h.tri[0];
         h.b1[i] = h.b1[0], h.b2[i] = h.b2[0], h.t[i] = h.t[0], h.dx[i] = h.dx[0], h.dy[i] = h.dy[0], h.dz[i] = h.dz[0];
         h.flip[i] = h.flip[0], h.vertex_normals[i] = h.vertex_normals[0], h.has_uv[i] = h.has_uv[0];
@@ -107,7 +107,7 @@ void fill_kernel(Shape::HitLanes &h) {
 }
 #else
 // The scalar fill, lane by lane, on CPUs without AVX.
-void fill_kernel(Shape::HitLanes &h) {
+void fill_kernel(HitLanes &h) {
     for (int i = 0; i < h.n; ++i) {
         const Vec3 d(h.dx[i], h.dy[i], h.dz[i]);
         SurfaceInteraction &si = *h.out[i];
@@ -119,7 +119,7 @@ void fill_kernel(Shape::HitLanes &h) {
 
 }  // namespace
 
-void Shape::fill_lanes(HitLanes &h) {
+void fill_lanes(HitLanes &h) {
     if (h.n == 0) return;
     fill_kernel(h);
     h.n = 0;

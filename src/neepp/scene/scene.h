@@ -7,6 +7,7 @@
 #include <embree3/rtcore.h>
 #include "neepp/base/light.h"
 #include "neepp/scene/camera.h"
+#include "neepp/scene/hit_lanes.h"
 #include "neepp/scene/shape.h"
 
 namespace neepp {
@@ -60,11 +61,11 @@ public:
         shapes_[hit.geom]->fill_interaction(hit.prim, hit.u, hit.v, ray, hit.t, si);
         si.wi = si.to_local(-ray.d);
     }
-    // fill(), or, for a hit that can be, queued in lanes to be filled with seven others (Shape::HitLanes):
-    // si is complete after the eighth, or Shape::fill_lanes.
-    void fill_in_lanes(Shape::HitLanes &lanes, const RayHit &hit, const Ray &ray, SurfaceInteraction &si) const {
+    // fill(), or, for a hit that can be, queued in lanes to be filled with seven others (HitLanes):
+    // si is complete after the eighth, or fill_lanes.
+    void fill_in_lanes(HitLanes &lanes, const RayHit &hit, const Ray &ray, SurfaceInteraction &si) const {
         const Shape &s = *shapes_[hit.geom];
-        if (s.fills_in_lanes()) s.add_lane(lanes, hit.prim, hit.u, hit.v, hit.t, ray.d, si);
+        if (s.fills_in_lanes()) add_lane(lanes, s, hit.prim, hit.u, hit.v, hit.t, ray.d, si);
         else fill(hit, ray, si);
     }
     bool occluded(const Ray &ray) const;

@@ -18,6 +18,8 @@ namespace neepp {
 class Light;
 class SdfGrid;
 
+struct HitLanes;
+
 struct PositionSample {
     Vec3 p, n;      // point on the surface and its geometric normal
     Vec3 ns;        // its shading normal (the interpolated vertex normal; n without vertex normals)
@@ -93,38 +95,9 @@ struct Shape {
     // b1 is the parameter along segment prim).
     void fill_interaction(uint32_t prim, float b1, float b2, const Ray &ray, float t,
                           SurfaceInteraction &si) const;
-    // Triangle hits waiting to be filled eight at a time (hit_lanes.cpp), as fill_interaction and then
-    // wi = to_local(-d) would fill them, one per lane, in SoA: what each lane's hit record is computed from.
-    // For meshes whose BSDF needs no tangents (fills_in_lanes()), which is most of every scene's hits.
-    static constexpr int kHitLanes = 8;
-    struct HitLanes {
-        alignas(32) float b1[kHitLanes], b2[kHitLanes], t[kHitLanes];  // barycentrics, ray distance
-        alignas(32) float dx[kHitLanes], dy[kHitLanes], dz[kHitLanes];  // ray direction
-        // The shape's options, as masks the kernel applies: -0 flips the normals (+0 not); all bits set
-        // where the mesh has vertex normals to interpolate (and face_normals is off) / texture coordinates.
-        alignas(32) float flip[kHitLanes], vertex_normals[kHitLanes], has_uv[kHitLanes];
-        const float *tri[kHitLanes];  // the triangle's record (HitTriangle)
-        const Shape *shape[kHitLanes];
-        uint32_t prim[kHitLanes];
-        SurfaceInteraction *out[kHitLanes];
-        int n = 0;  // lanes in use
-    };
+    // Whether its hits may be filled eight at a time (scene/hit_lanes.h): a mesh whose BSDF needs no
+    // tangents, which is most of every scene's hits.
     bool fills_in_lanes() const { return kind == Kind::Mesh && !tangents; }
-    // Queues a hit on triangle prim (fills_in_lanes() must hold); the eighth fills all of them.
-    void add_lane(HitLanes &h, uint32_t prim, float b1, float b2, float t, const Vec3 &d, SurfaceInteraction &out) const {
-        const int i = h.n++;
-        h.tri[i] = reinterpret_cast<const float *>(&hit_triangles_[prim]);
-        h.b1[i] = b1, h.b2[i] = b2, h.t[i] = t;
-        h.dx[i] = d.x, h.dy[i] = d.y, h.dz[i] = d.z;
-        h.flip[i] = lane_flip_, h.vertex_normals[i] = lane_vertex_normals_, h.has_uv[i] = lane_has_uv_;
-        h.shape[i] = this, h.prim[i] = prim, h.out[i] = &out;
-        if (h.n == kHitLanes) fill_lanes(h);
-    }
-    // Fills the queued hits and empties the lanes. The kernel costs as much for one lane as for eight, but
-    // filling the last few of a batch one at a time saves nothing, and each lane's result depends on
-    // nothing else: a path gets the same hit records, so the same image to the bit, whether it is traced
-    // alone or with others.
-    static void fill_lanes(HitLanes &h);
 
     // A mesh of two triangles forming a parallelogram (Mitsuba's `rectangle`, a quad from a file) is
     // sampled as one: p = corner + u.x e1 + u.y e2, with no triangle to choose. Its uv is affine in
@@ -149,6 +122,8 @@ struct Shape {
     }
 
 private:
+    friend void add_lane(HitLanes &h, const Shape &shape, uint32_t prim, float b1, float b2, float t, const Vec3 &d,
+                         SurfaceInteraction &out);
     // What a hit on one triangle reads, in one record: its corners, and its vertex normals and uvs where
     // the mesh has them. Through the index buffer, a hit read up to ten scattered cache lines (indices,
     // then three vertices in each of three arrays), most of them misses on a large scene, at a cost
