@@ -1,6 +1,7 @@
 // Mitsuba 3 XML parsing: the real scenes, parameters, references, transforms, and error messages.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
 #include <functional>
@@ -331,6 +332,48 @@ TEST(XmlTree, ErrorsNameFileAndLine) {
     } catch (const SceneError &e) {
         EXPECT_EQ(std::string(e.what()).rfind(missing + ":", 0), 0u) << e.what();
     }
+}
+
+// A scene file must not choose how deep the loader recurses: a million nested objects, and chains of <ref>s
+// too long in either order of the file, are errors at a line, not a stack overflow; a chain of 60 loads.
+TEST(XmlTree, NestingIsBoundedWhateverTheFile) {
+    TempDir tmp;
+    constexpr int kNested = 1000000;
+    std::string deep = "<scene version=\"3.0.0\">\n";
+    deep.reserve(size_t(kNested) * 32);
+    for (int i = 0; i < kNested; ++i) deep += "<bsdf type=\"twosided\">";
+    for (int i = 0; i < kNested; ++i) deep += "</bsdf>";
+    deep += "\n</scene>\n";
+    const std::string deep_path = tmp.write("deep.xml", deep);
+    expect_error([&] { parse_mitsuba_xml(deep_path); }, deep_path, 2, "nested more than 100 deep");
+
+    auto chain = [](int n, bool forward) {  // bsdf i refs bsdf i - 1; forward: each defined before its use
+        std::vector<std::string> lines;
+        for (int i = 0; i < n; ++i)
+            lines.push_back(i == 0 ? "<bsdf type=\"diffuse\" id=\"b0\"/>"
+                                   : "<bsdf type=\"twosided\" id=\"b" + std::to_string(i) + "\"><ref id=\"b" +
+                                         std::to_string(i - 1) + "\"/></bsdf>");
+        if (!forward) std::reverse(lines.begin(), lines.end());
+        std::string body = "<shape type=\"sphere\"><ref id=\"b" + std::to_string(n - 1) + "\"/></shape>\n";
+        for (const std::string &l : lines) body += l + "\n";
+        return scene(body);
+    };
+    for (bool forward : {true, false}) {
+        const std::string path = tmp.write(forward ? "chain.xml" : "reversed.xml", chain(100000, forward));
+        try {
+            parse_mitsuba_xml(path);
+            ADD_FAILURE() << "a chain of 100000 <ref>s loaded";
+        } catch (const SceneError &e) {
+            EXPECT_NE(std::string(e.what()).find("through <ref>s, more than 100 deep"), std::string::npos) << e.what();
+            EXPECT_GT(e.line, 1);
+        }
+    }
+    const std::string ok = tmp.write("ok.xml", chain(60, false));
+    const auto root = parse_mitsuba_xml(ok);
+    const XmlNode *node = root->children.at(0).get();  // the sphere, then its BSDF 60 deep
+    int depth = 0;
+    while (!node->children.empty()) node = node->children[0].get(), ++depth;
+    EXPECT_EQ(depth, 60);
 }
 
 // <spectrum>: pairs, a .spd file (found as other files are) and a constant, converted as Mitsuba 3's RGB

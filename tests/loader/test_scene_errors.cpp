@@ -35,6 +35,43 @@ std::string load_error(const std::string &xml, const std::string &file_name = "s
     return "";
 }
 
+// Objects nested through <ref>s: a chain as deep as the loader allows builds (the factories recurse along
+// it), one deeper is an error at its line; nested instancing is refused whatever the depth.
+TEST(SceneErrors, NestingThroughRefsIsBounded) {
+    auto chain = [](int n) {
+        std::string body = "<bsdf type=\"diffuse\" id=\"b0\"/>\n";
+        for (int i = 1; i < n; ++i)
+            body += "<bsdf type=\"twosided\" id=\"b" + std::to_string(i) + "\"><ref id=\"b" + std::to_string(i - 1) +
+                    "\"/></bsdf>\n";
+        return scene_with(body + "<shape type=\"sphere\"><ref id=\"b" + std::to_string(n - 1) + "\"/></shape>\n" + kLight);
+    };
+    auto scene = load_scene(write_temp_scene(chain(97)));  // scene > shape > 97 BSDFs: 99 objects deep
+    ASSERT_EQ(scene->shapes().size(), 1u);
+    EXPECT_TRUE(scene->shapes()[0]->bsdf->has_flag(BSDFDiffuseReflection));
+    EXPECT_NE(load_error(chain(200000)).find("more than 100 deep"), std::string::npos);
+    // Blends of blends of one shared BSDF: 2^depth evaluations at every shading point, refused past 64.
+    auto blends = [](int n) {
+        std::string body = "<bsdf type=\"diffuse\" id=\"b0\"/>\n";
+        for (int i = 1; i < n; ++i)
+            body += "<bsdf type=\"blendbsdf\" id=\"b" + std::to_string(i) + "\"><float name=\"weight\" value=\"0.5\"/><ref id=\"b" + std::to_string(i - 1) +
+                    "\"/><ref id=\"b" + std::to_string(i - 1) + "\"/></bsdf>\n";
+        return scene_with(body + "<shape type=\"sphere\"><ref id=\"b" + std::to_string(n - 1) + "\"/></shape>\n" + kLight);
+    };
+    EXPECT_NO_THROW(load_scene(write_temp_scene(blends(7))));  // 64 evaluations
+    EXPECT_NE(load_error(blends(60)).find("evaluates 128 nested BSDFs"), std::string::npos);
+    // Textures that each use the previous one twice, and twosided BSDFs whose back is their front: what
+    // the loader asks of them once (a mean, flags, the mesh attributes they read) must not take 2^depth
+    // calls (it took longer than any test runs, before).
+    std::string textures = "<texture type=\"checkerboard\" id=\"t0\"/>\n";
+    for (int i = 1; i < 60; ++i)
+        textures += "<texture type=\"checkerboard\" id=\"t" + std::to_string(i) + "\"><ref name=\"color0\" id=\"t" +
+                    std::to_string(i - 1) + "\"/><ref name=\"color1\" id=\"t" + std::to_string(i - 1) + "\"/></texture>\n";
+    auto textured = load_scene(write_temp_scene(scene_with(
+        textures + "<shape type=\"sphere\"><bsdf type=\"diffuse\"><ref name=\"reflectance\" id=\"t59\"/></bsdf>"
+                   "<emitter type=\"area\"><ref name=\"radiance\" id=\"t59\"/></emitter></shape>\n")));
+    EXPECT_EQ(textured->lights().size(), 1u);
+}
+
 TEST(SceneErrors, MalformedXmlNamesFileAndLine) {
     std::string msg = load_error("<scene version=\"3.0.0\">\n<shape type=\"sphere\">\n</scene>\n", "broken.xml");
     EXPECT_NE(msg.find("broken.xml:"), std::string::npos) << msg;

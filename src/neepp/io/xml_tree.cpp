@@ -229,6 +229,9 @@ const std::set<std::string_view> kObjectTags = {"shape",   "bsdf",       "textur
                                                 "rfilter", "sampler",    "integrator", "medium", "phase", "volume"};
 const std::set<std::string_view> kTransformOps = {"translate", "rotate", "scale", "lookat", "matrix"};
 constexpr int kMaxIncludeDepth = 15;  // Mitsuba's default; also stops include cycles
+// Objects nested in objects, in the file or through <ref>s: no scene needs nearly as many, and the loader
+// descends them recursively (parsing, resolving references, building), so a file must not choose how deep.
+constexpr int kMaxObjectDepth = 100;
 const char *kRefTag = "\x01ref";      // placeholder tag of an unresolved <ref>, never a real element name
 
 // One XML file in memory, with the byte offset of each line start for file:line messages.
@@ -262,10 +265,8 @@ public:
     std::shared_ptr<XmlNode> parse(const std::string &path) {
         std::shared_ptr<XmlNode> root = parse_file(path, 0);
         try {
-            std::set<const XmlNode *> seen;
-            resolve_refs(*root, seen);
-            std::set<const XmlNode *> done, active;
-            check_cycles(*root, done, active);
+            resolve_refs(*root);
+            check_nesting(*root);
         } catch (...) {
             // A <ref> cycle is a cycle of shared_ptrs, which would outlive the error: every cycle passes
             // through an object with an id (what a <ref> points to), so unlinking their children frees it.
@@ -286,6 +287,7 @@ private:
     std::string base_dir_;
     std::shared_ptr<std::vector<std::string>> search_dirs_ = std::make_shared<std::vector<std::string>>();
     std::vector<std::string> includer_dirs_;  // folders of the files whose <include> is being read, outermost first
+    int object_depth_ = 0;                    // make_object calls under way
 
     void add_param(const std::string &name, const std::string &value, bool from_default) {
         Param p{"$" + name, value, from_default};
@@ -386,6 +388,12 @@ private:
     }
 
     std::shared_ptr<XmlNode> make_object(const SourceFile &src, pugi::xml_node el, int depth) {
+        struct Nesting {
+            int &level;
+            ~Nesting() { --level; }
+        } nesting{++object_depth_};
+        if (object_depth_ > kMaxObjectDepth)
+            fail(src, el, "objects nested more than " + std::to_string(kMaxObjectDepth) + " deep (no scene needs so many)");
         auto node = std::make_shared<XmlNode>();
         // Mitsuba treats <spectrum type="..."> as a texture plugin.
         node->tag = std::string_view(el.name()) == "spectrum" ? "texture" : el.name();
@@ -666,25 +674,50 @@ private:
             add_child(src, el, parent, root->children[k], root->child_names[k]);
     }
 
-    void resolve_refs(XmlNode &node, std::set<const XmlNode *> &seen) {
-        if (!seen.insert(&node).second) return;
-        for (auto &c : node.children) {
-            if (c->tag == kRefTag) {
-                auto it = ids_.find(c->id);
-                if (it == ids_.end()) throw SceneError(c->file, c->line, "<ref>: unknown id \"" + c->id + "\"");
-                c = it->second;
+    // Replaces each <ref> by the object it names. Iterative, as the walk below: through <ref>s, how deep
+    // the objects go is the file's choice.
+    void resolve_refs(XmlNode &root) {
+        std::set<const XmlNode *> seen;
+        std::vector<XmlNode *> stack{&root};
+        while (!stack.empty()) {
+            XmlNode *node = stack.back();
+            stack.pop_back();
+            if (!seen.insert(node).second) continue;
+            for (auto &c : node->children) {
+                if (c->tag == kRefTag) {
+                    auto it = ids_.find(c->id);
+                    if (it == ids_.end()) throw SceneError(c->file, c->line, "<ref>: unknown id \"" + c->id + "\"");
+                    c = it->second;
+                }
+                stack.push_back(c.get());
             }
-            resolve_refs(*c, seen);
         }
     }
 
-    // A <ref> to an enclosing object would make the factory recurse forever.
-    void check_cycles(const XmlNode &node, std::set<const XmlNode *> &done, std::set<const XmlNode *> &active) {
-        if (done.count(&node)) return;
-        if (!active.insert(&node).second) throw node.error("object \"" + node.id + "\" contains itself through a <ref>");
-        for (const auto &c : node.children) check_cycles(*c, done, active);
-        active.erase(&node);
-        done.insert(&node);
+    // A <ref> to an enclosing object would make the factory recurse forever, and a chain of <ref>s as deep
+    // as the file likes would exhaust its stack: a walk with a stack of its own finds the first and
+    // measures the second (each object's height: the longest chain of objects below it).
+    void check_nesting(const XmlNode &root) {
+        std::map<const XmlNode *, int> height;  // of the objects walked; -1 while under way
+        std::vector<std::pair<const XmlNode *, size_t>> stack{{&root, 0}};
+        height[&root] = -1;
+        while (!stack.empty()) {
+            auto &[node, next] = stack.back();
+            if (next < node->children.size()) {
+                const XmlNode *c = node->children[next++].get();
+                auto [it, fresh] = height.emplace(c, -1);
+                if (fresh) stack.push_back({c, 0});
+                else if (it->second < 0) throw c->error("object \"" + c->id + "\" contains itself through a <ref>");
+                continue;
+            }
+            int h = 1;
+            for (const auto &c : node->children) h = std::max(h, height.at(c.get()) + 1);
+            if (h > kMaxObjectDepth)
+                throw node->error("objects nested, through <ref>s, more than " + std::to_string(kMaxObjectDepth) +
+                                  " deep (no scene needs so many)");
+            height[node] = h;
+            stack.pop_back();
+        }
     }
 };
 

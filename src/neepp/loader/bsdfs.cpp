@@ -188,6 +188,21 @@ BSDFPtr Factories::bsdf(const XmlNode &node) {
     } catch (const std::exception &e) {  // a constructor's validation, located at its element
         throw node.error(e.what());
     }
+    // How many BSDFs it evaluates at each shading point: a blend evaluates both of its own, a wrapper one.
+    // Blends of blends of one shared BSDF double it at every level, so a file could make each shading
+    // point cost 2^depth evaluations: a render that never ends.
+    int cost = 1;
+    if (const auto nested = node.children_with_tag("bsdf"); !nested.empty()) {
+        cost = 0;
+        for (const auto &child : nested) {
+            const int c = bsdf_cost_.count(child.get()) ? bsdf_cost_.at(child.get()) : 1;
+            cost = node.type == "blendbsdf" ? cost + c : std::max(cost, c);
+        }
+    }
+    if (cost > kMaxBsdfEvaluations)
+        throw node.error("this BSDF evaluates " + std::to_string(cost) + " nested BSDFs at every shading point "
+                         "(blendbsdfs of blendbsdfs); at most " + std::to_string(kMaxBsdfEvaluations));
+    bsdf_cost_[&node] = cost;
     warn_unused(node);
     bsdfs_[&node] = b;
     return b;

@@ -41,6 +41,9 @@ private:
     HairParams hair_params(const XmlNode &node);
     std::map<const XmlNode *, TexturePtr> textures_;
     std::map<const XmlNode *, BSDFPtr> bsdfs_;
+    // Nested BSDFs each built BSDF evaluates per shading point (Factories::bsdf), and their bound.
+    static constexpr int kMaxBsdfEvaluations = 64;
+    std::map<const XmlNode *, int> bsdf_cost_;
     std::map<const XmlNode *, std::vector<Shape>> shape_groups_;
     BSDFPtr default_bsdf_, black_bsdf_;
 };

@@ -1,3 +1,5 @@
+#include <set>
+#include <vector>
 #include <fmt/core.h>
 #include "neepp/loader/supported_plugins.h"
 #include "neepp/loader/factories.h"
@@ -63,19 +65,28 @@ TexturePtr Factories::texture(const XmlNode &node) {
 }
 
 void check_mesh_attributes(const XmlNode &bsdf_node, const Shape &shape, const XmlNode &shape_node) {
-    for (const auto &child : bsdf_node.children) {
-        if (child->tag == "texture" && child->type == "mesh_attribute") {
-            const std::string name = child->get_string("name");
-            if (!shape.attribute(name)) {
-                std::string have;
-                if (shape.attributes)
-                    for (const MeshAttribute &a : *shape.attributes) have += (have.empty() ? "" : ", ") + a.name;
-                throw shape_node.error("has no mesh attribute \"" + name + "\" (read by the mesh_attribute texture at " +
-                                       child->file + ":" + std::to_string(child->line) + "); it has " +
-                                       (have.empty() ? std::string("none") : have));
+    // Each object once: through <ref>s the objects under a BSDF are a graph, which a walk of every path
+    // would take 2^depth steps over (a chain of textures that each use the previous one twice).
+    std::set<const XmlNode *> seen;
+    std::vector<const XmlNode *> stack{&bsdf_node};
+    while (!stack.empty()) {
+        const XmlNode *node = stack.back();
+        stack.pop_back();
+        for (const auto &child : node->children) {
+            if (!seen.insert(child.get()).second) continue;
+            if (child->tag == "texture" && child->type == "mesh_attribute") {
+                const std::string name = child->get_string("name");
+                if (!shape.attribute(name)) {
+                    std::string have;
+                    if (shape.attributes)
+                        for (const MeshAttribute &a : *shape.attributes) have += (have.empty() ? "" : ", ") + a.name;
+                    throw shape_node.error("has no mesh attribute \"" + name + "\" (read by the mesh_attribute texture at " +
+                                           child->file + ":" + std::to_string(child->line) + "); it has " +
+                                           (have.empty() ? std::string("none") : have));
+                }
             }
+            stack.push_back(child.get());
         }
-        check_mesh_attributes(*child, shape, shape_node);
     }
 }
 

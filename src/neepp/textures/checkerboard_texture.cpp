@@ -5,7 +5,8 @@
 namespace neepp {
 
 CheckerboardTexture::CheckerboardTexture(TexturePtr color0, TexturePtr color1, const Transform &to_uv)
-    : color0_(std::move(color0)), color1_(std::move(color1)), to_uv_(to_uv) {}
+    : color0_(std::move(color0)), color1_(std::move(color1)), to_uv_(to_uv),
+      mean_((color0_->mean() + color1_->mean()) * 0.5f) {}
 
 bool CheckerboardTexture::same_parity(const SurfaceInteraction &si) const {
     const Vec2 uv = to_uv_.apply(si.uv);
@@ -21,6 +22,6 @@ float CheckerboardTexture::eval_1(const SurfaceInteraction &si) const {
     return same_parity(si) ? color1_->eval_1(si) : color0_->eval_1(si);
 }
 
-Color CheckerboardTexture::mean() const { return (color0_->mean() + color1_->mean()) * 0.5f; }
+Color CheckerboardTexture::mean() const { return mean_; }
 
 }  // namespace neepp

@@ -27,6 +27,9 @@ private:
 
     TexturePtr color0_, color1_;
     UvTransform to_uv_;
+    // Read once: asked at every call, a chain of checkerboards that each use the previous one twice would
+    // cost 2^depth calls.
+    Color mean_;
 };
 
 }  // namespace neepp
