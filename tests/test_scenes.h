@@ -56,13 +56,18 @@ struct RenderedImage {
     RenderResult result;
 };
 
+// The options given, and the scene file's integrator options that they do not set.
+inline Options with_scene_options(const Scene &scene, const Options &options) {
+    Options o = options;
+    for (auto &[k, v] : scene.settings.integrator_options)
+        if (!o.has(k)) o.set(k, v);
+    return o;
+}
+
 inline RenderedImage render_scene_file(const std::string &path, int spp, uint64_t seed, const Options &options,
                                        const std::string &integrator = "path", const std::string &sampler = "independent") {
     auto scene = load_scene(path);
-    Options o = options;
-    for (auto &[k, v] : scene->settings.integrator_options)
-        if (!o.has(k)) o.set(k, v);
-    auto integ = make_integrator(integrator, o);
+    auto integ = make_integrator(integrator, with_scene_options(*scene, options));
     RenderJob job;
     job.spp = spp;
     job.seed = seed;

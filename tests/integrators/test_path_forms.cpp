@@ -109,13 +109,6 @@ std::string describe(const Family &f, const OptionMap &o) {
     return s;
 }
 
-Options with_scene_options(const Scene &scene, const OptionMap &o) {
-    Options options{o};
-    for (const auto &[k, v] : scene.settings.integrator_options)
-        if (!options.has(k)) options.set(k, v);
-    return options;
-}
-
 struct SampleAgreement {
     int samples = 0, exact = 0, close = 0, nonzero = 0;
     RenderCounters fast, reference;
@@ -126,7 +119,7 @@ struct SampleAgreement {
 // its rejection decided, what it learned merged).
 SampleAgreement compare_samples(const Family &family, const OptionMap &o) {
     auto scene = load_scene(write_temp_scene(family.xml()));
-    auto integrator = make_integrator("path", with_scene_options(*scene, o));
+    auto integrator = make_integrator("path", with_scene_options(*scene, Options(o)));
     RenderJob warm_up;
     warm_up.spp = 3;
     warm_up.seed = 11;
@@ -201,8 +194,8 @@ TEST(PathForms, SameRadianceSampleBySample) {
 // sampling alone and NEE, of the same image): sample by sample they must disagree.
 TEST(PathForms, SampleCheckSeesADifferentEstimator) {
     auto scene = load_scene(write_temp_scene(kGlossyRoomXml));
-    auto nee_owned = make_integrator("path", with_scene_options(*scene, {}));
-    auto bsdf_only_owned = make_integrator("path", with_scene_options(*scene, {{"nee", "false"}}));
+    auto nee_owned = make_integrator("path", with_scene_options(*scene, Options()));
+    auto bsdf_only_owned = make_integrator("path", with_scene_options(*scene, Options(OptionMap{{"nee", "false"}})));
     auto *nee = dynamic_cast<RayIntegrator *>(nee_owned.get());
     auto *bsdf_only = dynamic_cast<RayIntegrator *>(bsdf_only_owned.get());
     nee->prepare(*scene);

@@ -116,10 +116,6 @@ public:
 // sample), into out: through the integrator's fast form where it has one, else Li one ray at a time.
 void Li_batch(const RayIntegrator &integrator, const Scene &scene, std::span<const Ray> rays,
               std::span<Sampler *const> samplers, std::span<Color> out, RenderCounters &counters);
-// One camera sample of a ray or splatting integrator (its splats, if any, into splats); PSSMLT's chains
-// evaluate their inner integrator this way. Throws std::invalid_argument for a PassIntegrator.
-Color Li_sample(const Integrator &integrator, const Scene &scene, const Ray &ray, Sampler &sampler,
-                RenderCounters &counters, SplatSink &splats);
 // Whether the integrator's samples splat: a SplattingIntegrator's or a PassIntegrator's.
 bool splats(const Integrator &integrator);
 

@@ -44,9 +44,9 @@ void record(SplatFilm &film, const std::vector<PSSMLTIntegrator::Contribution> &
 }  // namespace
 
 PSSMLTIntegrator::PSSMLTIntegrator(PSSMLTOptions options, std::unique_ptr<Integrator> inner)
-    : options_(options), inner_(std::move(inner)) {
-    if (dynamic_cast<const PassIntegrator *>(inner_.get()))
-        throw std::invalid_argument("pssmlt: the inner integrator must render per sample");
+    : options_(options), inner_(std::move(inner)), inner_rays_(dynamic_cast<const RayIntegrator *>(inner_.get())),
+      inner_splats_(dynamic_cast<const SplattingIntegrator *>(inner_.get())) {
+    if (!inner_rays_ && !inner_splats_) throw std::invalid_argument("pssmlt: the inner integrator must render per sample");
 }
 
 void PSSMLTIntegrator::prepare(const Scene &scene) {
@@ -68,7 +68,13 @@ float PSSMLTIntegrator::evaluate(const Scene &scene, PrimarySampleSpaceSampler &
     const Vec2 lens = cam.has_lens() ? sampler.next_2d() : Vec2(0.5f, 0.5f);
     const Ray ray = cam.generate_ray(u, lens);
     ContributionList splats(out);
-    const Color L = Li_sample(*inner_, scene, ray, sampler, counters, splats);
+    Color L;
+    if (inner_splats_) {
+        L = inner_splats_->Li(scene, ray, sampler, counters, splats);
+    } else {  // the inner integrator's own form: the fast one where it has one, a batch of this one ray
+        Sampler *const samplers[1] = {&sampler};
+        Li_batch(*inner_rays_, scene, std::span<const Ray>(&ray, 1), samplers, std::span<Color>(&L, 1), counters);
+    }
     if (is_finite(L)) out.push_back({Vec2(u.x * float(cam.width), u.y * float(cam.height)), L});
     else ++counters.invalid_samples;
     float f = 0;

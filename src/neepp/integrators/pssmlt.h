@@ -77,6 +77,9 @@ private:
 
     PSSMLTOptions options_;
     std::unique_ptr<Integrator> inner_;
+    // inner_ as its family: one of the two is set (read once here, not at every sample).
+    const RayIntegrator *inner_rays_;
+    const SplattingIntegrator *inner_splats_;
     std::vector<Chain> chains_;
     // The chains as the pass under way found them: a pass cut short is not in a checkpoint (the render
     // loop keeps whole passes), so neither are its mutations.

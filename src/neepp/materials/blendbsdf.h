@@ -3,34 +3,30 @@
 // direction from a smooth lobe then gets the blend's own density, the two pdfs weighted alike, so that its
 // weight is the blended eval over it.
 #pragma once
-#include "neepp/base/bsdf.h"
+#include "neepp/materials/nesting_bsdf.h"
 
 namespace neepp {
 
-class BlendBSDF final : public BSDF {
+class BlendBSDF final : public NestingBSDF {
 public:
     BlendBSDF(TexturePtr weight, BSDFPtr first, BSDFPtr second)
-        : weight_(std::move(weight)), first_(std::move(first)), second_(std::move(second)),
-          flags_(first_->flags() | second_->flags()), tangents_(first_->needs_tangents() || second_->needs_tangents()) {}
+        : NestingBSDF({first.get(), second.get()}), weight_(std::move(weight)), first_(std::move(first)),
+          second_(std::move(second)) {}
     Color eval(const BSDFContext &ctx, const SurfaceInteraction &si, const Vec3 &wi, const Vec3 &wo) const override;
     float pdf(const BSDFContext &ctx, const SurfaceInteraction &si, const Vec3 &wi, const Vec3 &wo) const override;
     BSDFEval eval_pdf(const BSDFContext &ctx, const SurfaceInteraction &si, const Vec3 &wi, const Vec3 &wo) const override;
     BSDFSample sample(const BSDFContext &ctx, const SurfaceInteraction &si, const Vec3 &wi, float u1,
                       Vec2 u2) const override;
-    uint32_t flags() const override { return flags_; }  // read once (TwoSidedBSDF says why)
     void prefetch(const SurfaceInteraction &si) const override {
         weight_->prefetch(si);
         first_->prefetch(si);
         second_->prefetch(si);
     }
-    bool needs_tangents() const override { return tangents_; }
 
 private:
     float weight(const SurfaceInteraction &si) const;
     TexturePtr weight_;
     BSDFPtr first_, second_;
-    uint32_t flags_;
-    bool tangents_;
 };
 
 }  // namespace neepp

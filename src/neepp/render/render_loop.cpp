@@ -139,8 +139,17 @@ private:
     bool cancelled() const { return job_.cancel && job_.cancel->load(); }
     // One pass of `size` samples per pixel into pass_block_ (and splats_pass_); false when it was cut short.
     bool render_pass(int size);
+    // What a thread of the tile loop reuses from tile to tile: a batch's samplers, rays, film positions
+    // and radiances.
+    struct Batch {
+        std::vector<std::unique_ptr<Sampler>> owned;
+        std::vector<Sampler *> samplers;
+        std::vector<Ray> rays;
+        std::vector<Vec2> film_pos;
+        std::vector<Color> radiance;
+    };
     // The tile loop's share of a pass: each tile's samples, in batches, into the tile's block.
-    void render_tile(size_t index, int s0, int size, std::vector<Sampler *> &samplers, RenderCounters &c);
+    void render_tile(size_t index, int s0, int size, Batch &batch, RenderCounters &c);
     void merge_pass(uint64_t pass_light_paths);
     // Light paths the pass's camera samples splatted (an integrator's own pass body counts its own).
     double camera_sample_light_paths() const {
@@ -309,13 +318,12 @@ bool RenderLoop::render_pass(int size) {
         tbb::parallel_for(tbb::blocked_range<size_t>(0, tiles_.size(), 1), [&](const tbb::blocked_range<size_t> &r) {
             const DenormalsAreZero ftz;
             // Samples go to the integrator in batches (its fast form, RayIntegrator::batch), each with its own sampler.
-            std::vector<std::unique_ptr<Sampler>> owned;
-            std::vector<Sampler *> samplers;
-            for (int k = 0; k < kBatch; ++k) samplers.push_back(owned.emplace_back(prototype_->clone()).get());
+            Batch batch{{}, {}, std::vector<Ray>(kBatch), std::vector<Vec2>(kBatch), std::vector<Color>(kBatch)};
+            for (int k = 0; k < kBatch; ++k) batch.samplers.push_back(batch.owned.emplace_back(prototype_->clone()).get());
             RenderCounters &c = counters_.local();
             for (size_t ti = r.begin(); ti != r.end(); ++ti) {
                 if (aborted_.load(std::memory_order_relaxed) || must_stop()) return;
-                render_tile(ti, s0, size, samplers, c);
+                render_tile(ti, s0, size, batch, c);
             }
         });
     });
@@ -328,11 +336,12 @@ bool RenderLoop::render_pass(int size) {
     return true;
 }
 
-void RenderLoop::render_tile(size_t index, int s0, int size, std::vector<Sampler *> &samplers, RenderCounters &c) {
+void RenderLoop::render_tile(size_t index, int s0, int size, Batch &batch, RenderCounters &c) {
     const Tile &t = tiles_[index];
-    std::vector<Ray> rays(kBatch);
-    std::vector<Vec2> film_pos(kBatch);
-    std::vector<Color> radiance(kBatch);
+    std::vector<Sampler *> &samplers = batch.samplers;
+    std::vector<Ray> &rays = batch.rays;
+    std::vector<Vec2> &film_pos = batch.film_pos;
+    std::vector<Color> &radiance = batch.radiance;
     double m2 = 0;
     ImageBlock block(t.x0 - border_, t.y0 - border_, t.w + 2 * border_, t.h + 2 * border_, &filter_);
     int queued = 0;
