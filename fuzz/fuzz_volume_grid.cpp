@@ -9,7 +9,7 @@
 #include "common/volume_grid_writer.h"
 #include "fuzz_input.h"
 #include "neepp/io/volume_grid_reader.h"
-#include "neepp/scene/sdf_grid.h"
+#include "neepp/shapes/sdf_grid.h"
 
 namespace {
 

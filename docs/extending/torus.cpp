@@ -1,6 +1,6 @@
 // A shape: a torus around the z axis, as a triangle mesh. A shape plugin makes the mesh in its own space;
 // the loader places it by to_world, gives it its BSDF and area emitter, and traces it with Embree as it does
-// every mesh (a shape that is not a mesh, as sphere is, needs its own intersection in scene/).
+// every mesh (a shape that is not a mesh, as sphere is, implements base/shape.h's interface).
 #include <cmath>
 #include "neepp/loader/plugins.h"
 

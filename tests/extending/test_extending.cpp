@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 #include <cmath>
 #include "../../docs/extending/examples.h"
+#include "neepp/shapes/triangle_mesh.h"
 #include "neepp/integrators/factory.h"
 #include "neepp/loader/plugins.h"
 #include "neepp/math/warp.h"
@@ -143,7 +144,7 @@ std::string torus_xml(const std::string &integrator) {
 
 TEST_F(Extending, TorusHasItsAreaAndItsHole) {
     auto scene = load_scene(write_temp_scene(torus_xml("path")));
-    const Shape &torus = *scene->shapes().at(0);
+    const auto &torus = dynamic_cast<const TriangleMesh &>(*scene->shapes().at(0));
     double area = 0;
     for (size_t t = 0; t + 2 < torus.indices.size(); t += 3) {
         const Vec3 &a = torus.positions[torus.indices[t]];

@@ -1,6 +1,7 @@
 // LightBounds: cone unions hold both cones, and the importance bound is conservative: wherever it is
 // zero, no point of the light can send light to the receiver (else the BVH sampler would be biased).
 #include <gtest/gtest.h>
+#include "neepp/shapes/triangle_mesh.h"
 #include "neepp/base/light_bounds.h"
 #include "neepp/base/texture.h"
 #include "neepp/lights/area_light.h"
@@ -45,7 +46,7 @@ TEST(LightBounds, ImportanceIsZeroOnlyWhereTheLightCannotReach) {
     PCG32 rng(11, 2);
     int zero = 0, positive = 0;
     for (int t = 0; t < 400; ++t) {
-        Shape rect;
+        TriangleMesh rect;
         Vec3 c(4 * rng.next_float() - 2, 4 * rng.next_float() - 2, 4 * rng.next_float() - 2);
         Vec3 n = square_to_uniform_sphere(rng.next_2d());
         Frame f(n);

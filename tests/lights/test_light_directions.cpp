@@ -7,6 +7,7 @@
 #include <sstream>
 
 #include "common/chi2.h"
+#include "neepp/shapes/triangle_mesh.h"
 #include "neepp/lights/area_light.h"
 #include "neepp/lights/environment_light.h"
 #include "neepp/textures/checkerboard_texture.h"
@@ -25,7 +26,7 @@ using Trace = std::function<std::optional<Seen>(const Vec3 &ref, const Vec3 &d)>
 
 // Nearest hit of a ray with a mesh shape (Möller-Trumbore in double precision), completed by the
 // shape's own fill_interaction as Embree hits are.
-std::optional<SurfaceInteraction> intersect(const Shape &shape, const Ray &ray) {
+std::optional<SurfaceInteraction> intersect(const TriangleMesh &shape, const Ray &ray) {
     std::optional<SurfaceInteraction> best;
     double best_t = kInfinity;
     using D3 = std::array<double, 3>;
@@ -56,7 +57,7 @@ std::optional<SurfaceInteraction> intersect(const Shape &shape, const Ray &ray) 
     return best;
 }
 
-Trace trace_area(const Shape &shape, const AreaLight &light) {
+Trace trace_area(const TriangleMesh &shape, const AreaLight &light) {
     return [&shape, &light](const Vec3 &ref, const Vec3 &d) -> std::optional<Seen> {
         std::optional<SurfaceInteraction> si = intersect(shape, Ray{ref, d});
         if (!si) return std::nullopt;
@@ -146,8 +147,8 @@ TexturePtr checker_radiance() {
 
 // A 2 x 1 rectangle through the origin, tilted so that its normal is (0, -0.8, 0.6), with texture
 // coordinates.
-Shape make_rectangle() {
-    Shape s;
+TriangleMesh make_rectangle() {
+    TriangleMesh s;
     Vec3 e1(1.f, 0.f, 0.f), e2 = Vec3(0.f, 0.6f, 0.8f) * 0.5f;
     s.positions = {-e1 - e2, e1 - e2, e1 + e2, -e1 + e2};
     s.uvs = {Vec2(0, 0), Vec2(1, 0), Vec2(1, 1), Vec2(0, 1)};
@@ -158,8 +159,8 @@ Shape make_rectangle() {
 
 // The same rectangle with texture coordinates that are not affine over it (one corner's uv moved): a
 // point's uv is then the hit triangle's interpolation, which sampling must reproduce triangle by triangle.
-Shape make_rectangle_bent_uv() {
-    Shape s = make_rectangle();
+TriangleMesh make_rectangle_bent_uv() {
+    TriangleMesh s = make_rectangle();
     s.uvs[3] = Vec2(0.f, 0.5f);
     s.finalize();
     return s;
@@ -168,8 +169,8 @@ Shape make_rectangle_bent_uv() {
 // The rectangle with vertex normals leaning 60 degrees toward -e1 at one end and +e1 at the other: the side
 // its shading normal faces, which emits, then varies over it (Mitsuba's convention), and a reference point
 // off to one side sees part of the front face dark.
-Shape make_rectangle_bent_normals() {
-    Shape s = make_rectangle();
+TriangleMesh make_rectangle_bent_normals() {
+    TriangleMesh s = make_rectangle();
     const Vec3 n = normalize(cross(s.positions[1] - s.positions[0], s.positions[2] - s.positions[0]));
     const Vec3 e1 = normalize(s.positions[1] - s.positions[0]);
     const Vec3 left = n * 0.5f - e1 * 0.866f, right = n * 0.5f + e1 * 0.866f;
@@ -179,8 +180,8 @@ Shape make_rectangle_bent_normals() {
 }
 
 // Two triangles sharing a diagonal, of areas 0.5 and 1.5, that do not form a parallelogram.
-Shape make_kite() {
-    Shape s;
+TriangleMesh make_kite() {
+    TriangleMesh s;
     s.positions = {{0, 0, 0}, {1, -0.4f, 0}, {2.5f, 0, 0}, {1, 1.2f, 0}};
     s.uvs = {Vec2(0, 0), Vec2(1, 0), Vec2(1, 1), Vec2(0, 1)};
     s.indices = {0, 1, 2, 0, 2, 3};
@@ -191,8 +192,8 @@ Shape make_kite() {
 // Coplanar triangles (z = 0) whose areas differ by a factor of 1600, one of them wound to face away
 // (-z), and no texture coordinates. Coplanar and disjoint, they never overlap as seen from a point, so
 // each direction shows at most one point of the light, as the per-point pdf_direction assumes.
-Shape make_uneven_mesh() {
-    Shape s;
+TriangleMesh make_uneven_mesh() {
+    TriangleMesh s;
     s.positions = {{0, 0, 0},       {2, 0, 0},      {0, 2, 0},        // area 2
                    {2.1f, 0, 0},    {2.15f, 0, 0},  {2.1f, 0.05f, 0},  // area 0.00125
                    {0.5f, 2.2f, 0}, {1.5f, 2.2f, 0}, {1.5f, 2.7f, 0},  // area 0.25
@@ -230,7 +231,7 @@ SphereChi2Config band_below(const Shape &shape, const Vec3 &ref) {
 
 struct AreaCase {
     const char *name;
-    Shape (*make)();
+    TriangleMesh (*make)();
     Vec3 ref;
 };
 
@@ -255,14 +256,14 @@ class AreaLightSampling : public ::testing::TestWithParam<AreaCase> {};
 
 TEST_P(AreaLightSampling, SamplesMatchTracedPdfAndRadiance) {
     const AreaCase &c = GetParam();
-    Shape shape = c.make();
+    TriangleMesh shape = c.make();
     AreaLight light(&shape, checker_radiance());
     expect_samples_match_trace(light, c.ref, trace_area(shape, light));
 }
 
 TEST_P(AreaLightSampling, DirectionsFollowPdf) {
     const AreaCase &c = GetParam();
-    Shape shape = c.make();
+    TriangleMesh shape = c.make();
     AreaLight light(&shape, checker_radiance());
     Chi2Result r = chi2_light(light, c.ref, trace_area(shape, light), band_below(shape, c.ref));
     ASSERT_TRUE(r.error.empty()) << r.describe();
@@ -278,7 +279,7 @@ INSTANTIATE_TEST_SUITE_P(Lights, AreaLightSampling, ::testing::ValuesIn(kAreaCas
 // the per-triangle mapping is not. With uvs that are not affine over it, a sample that needs its uv takes
 // the triangles' way, and one that does not still the parallelogram's.
 TEST(AreaLight, ParallelogramSamplesAreAffineInU) {
-    auto affine = [](const Shape &shape, bool with_uv) {
+    auto affine = [](const TriangleMesh &shape, bool with_uv) {
         const PositionSample o = shape.sample_position(Vec2(0.f, 0.f), with_uv),
                              a = shape.sample_position(Vec2(1.f, 0.f), with_uv),
                              b = shape.sample_position(Vec2(0.f, 1.f), with_uv);
@@ -304,7 +305,7 @@ TEST(AreaLight, ParallelogramSamplesAreAffineInU) {
 
 TEST(AreaLight, UnevenMeshLosesExactlyTheBackFacingArea) {
     // Sanity of the case above: the one back-facing triangle holds 0.4 of the 2.65125 total area.
-    Shape shape = make_uneven_mesh();
+    TriangleMesh shape = make_uneven_mesh();
     EXPECT_NEAR(shape.surface_area(), 2.65125f, 1e-5f);
     AreaLight light(&shape, constant_texture(1.f));
     const Vec3 ref(1.f, 1.f, 1.5f);
@@ -315,7 +316,7 @@ TEST(AreaLight, UnevenMeshLosesExactlyTheBackFacingArea) {
 TEST(AreaLight, ShadingNormalDecidesTheSideThatEmits) {
     // Seen from far along +e1 and a little above, the end of the bent rectangle whose normals lean toward
     // -e1 faces away, though the face itself is seen from the front: the light shows only its other part.
-    Shape shape = make_rectangle_bent_normals();
+    TriangleMesh shape = make_rectangle_bent_normals();
     AreaLight light(&shape, constant_texture(1.f));
     const Vec3 ref(6.f, -0.3f, 0.4f);
     int lit = 0, dark = 0;
@@ -334,7 +335,7 @@ TEST(AreaLight, ShadingNormalDecidesTheSideThatEmits) {
 }
 
 TEST(AreaLight, BackSideIsDark) {
-    Shape shape = make_rectangle();
+    TriangleMesh shape = make_rectangle();
     AreaLight light(&shape, constant_texture(1.f));
     Vec3 behind(0.1f, 0.8f, -0.6f);  // -normal side
     PCG32 rng(3, 3);

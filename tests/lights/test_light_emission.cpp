@@ -3,6 +3,7 @@
 // carry the light's flux (E[Le |cos| / (pdf_pos pdf_dir)] is the emitted power).
 #include <gtest/gtest.h>
 #include "common/chi2.h"
+#include "neepp/shapes/sphere.h"
 #include "neepp/base/texture.h"
 #include "neepp/lights/area_light.h"
 #include "neepp/lights/directional_light.h"
@@ -18,9 +19,8 @@ using namespace neepp::test;
 
 namespace {
 
-Shape make_sphere(bool flip) {
-    Shape s;
-    s.kind = Shape::Kind::Sphere;
+Sphere make_sphere(bool flip) {
+    Sphere s;
     s.center = Vec3(0.3f, -0.2f, 1.f);
     s.radius = 0.7f;
     s.flip_normals = flip;
@@ -83,7 +83,7 @@ double mean_flux(const Light &light, int n = 400000) {
 
 TEST(LightEmission, AreaLightRaysFollowTheirDensities) {
     for (bool flip : {false, true}) {
-        Shape shape = make_sphere(flip);
+        Sphere shape = make_sphere(flip);
         AreaLight light(&shape, constant_texture(Color(2.f, 1.f, 0.5f)));
         light.prepare(shape.bounds());
         expect_round_trip(light);

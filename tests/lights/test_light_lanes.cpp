@@ -5,6 +5,8 @@
 
 #include <random>
 
+#include "neepp/shapes/sphere.h"
+#include "neepp/shapes/triangle_mesh.h"
 #include "neepp/lights/area_light.h"
 #include "neepp/lights/light_lanes.h"
 #include "neepp/textures/checkerboard_texture.h"
@@ -13,8 +15,8 @@ namespace neepp::test {
 namespace {
 
 // A parallelogram from corner c and edges e1, e2 (two triangles, as Mitsuba's rectangle), flipped if asked.
-Shape make_parallelogram(Vec3 c, Vec3 e1, Vec3 e2, bool flip) {
-    Shape s;
+TriangleMesh make_parallelogram(Vec3 c, Vec3 e1, Vec3 e2, bool flip) {
+    TriangleMesh s;
     s.positions = {c, c + e1, c + e1 + e2, c + e2};
     s.indices = {0, 1, 2, 0, 2, 3};
     s.flip_normals = flip;
@@ -30,8 +32,8 @@ TEST(LightLanes, SameSamplesAsOneAtATime) {
     if (!LightSampleLanes::kEnabled) GTEST_SKIP() << "no AVX: lights are sampled one at a time";
     // Two lights of different size, tilt, radiance and side, mixed in the same lanes; no edge has a zero
     // coordinate, so that each of u and v moves every coordinate of the point.
-    Shape a = make_parallelogram(Vec3(-1.f, 2.f, -0.5f), Vec3(2.f, 0.4f, -0.3f), Vec3(0.2f, 0.3f, 1.f), false);
-    Shape b = make_parallelogram(Vec3(0.5f, -1.f, 1.f), Vec3(-0.1f, 0.5f, 0.3f), Vec3(0.2f, 0.25f, -0.7f), true);
+    TriangleMesh a = make_parallelogram(Vec3(-1.f, 2.f, -0.5f), Vec3(2.f, 0.4f, -0.3f), Vec3(0.2f, 0.3f, 1.f), false);
+    TriangleMesh b = make_parallelogram(Vec3(0.5f, -1.f, 1.f), Vec3(-0.1f, 0.5f, 0.3f), Vec3(0.2f, 0.25f, -0.7f), true);
     AreaLight la(&a, constant_texture(Color(3.f, 2.f, 1.f))), lb(&b, constant_texture(Color(0.5f, 7.f, 0.25f)));
     const BBox bounds{Vec3(-5.f), Vec3(5.f)};
     la.prepare(bounds), lb.prepare(bounds);
@@ -88,7 +90,7 @@ TEST(LightLanes, SameSamplesAsOneAtATime) {
 
 TEST(LightLanes, PointOnTheLightIsInvalid) {
     if (!LightSampleLanes::kEnabled) GTEST_SKIP() << "no AVX: lights are sampled one at a time";
-    Shape s = make_parallelogram(Vec3(0.f), Vec3(1.f, 0.f, 0.f), Vec3(0.f, 1.f, 0.f), false);
+    TriangleMesh s = make_parallelogram(Vec3(0.f), Vec3(1.f, 0.f, 0.f), Vec3(0.f, 1.f, 0.f), false);
     AreaLight light(&s, constant_texture(1.f));
     light.prepare(BBox{Vec3(-1.f), Vec3(1.f)});
     LightSample out;
@@ -101,14 +103,14 @@ TEST(LightLanes, PointOnTheLightIsInvalid) {
 
 TEST(LightLanes, OnlyConstantParallelogramsTakeLanes) {
     const BBox bounds{Vec3(-1.f), Vec3(1.f)};
-    Shape quad = make_parallelogram(Vec3(0.f), Vec3(1.f, 0.f, 0.f), Vec3(0.f, 1.f, 0.f), false);
+    TriangleMesh quad = make_parallelogram(Vec3(0.f), Vec3(1.f, 0.f, 0.f), Vec3(0.f, 1.f, 0.f), false);
     // Textured radiance needs the sampled point's uv and a lookup: one at a time.
     AreaLight textured(&quad, std::make_shared<CheckerboardTexture>(constant_texture(1.f), constant_texture(0.f),
                                                                    Transform::scale(Vec3(4.f))));
     textured.prepare(bounds);
     EXPECT_EQ(textured.lane_record(), nullptr);
     // A mesh that is not a parallelogram chooses a triangle first.
-    Shape triangle;
+    TriangleMesh triangle;
     triangle.positions = {Vec3(0.f), Vec3(1.f, 0.f, 0.f), Vec3(0.f, 1.f, 0.f)};
     triangle.indices = {0, 1, 2};
     triangle.finalize();
@@ -116,8 +118,7 @@ TEST(LightLanes, OnlyConstantParallelogramsTakeLanes) {
     on_triangle.prepare(bounds);
     EXPECT_EQ(on_triangle.lane_record(), nullptr);
     // A sphere.
-    Shape sphere;
-    sphere.kind = Shape::Kind::Sphere;
+    Sphere sphere;
     sphere.radius = 1.f;
     sphere.finalize();
     AreaLight on_sphere(&sphere, constant_texture(1.f));

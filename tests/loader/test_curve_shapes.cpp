@@ -5,6 +5,7 @@
 
 #include <filesystem>
 #include <fstream>
+#include "neepp/shapes/curve_shape.h"
 #include "neepp/loader/supported_plugins.h"
 #include "test_scenes.h"
 
@@ -47,7 +48,7 @@ TEST(CurveShapes, ToWorldMovesControlPointsButNotRadii) {
                                                  "-1.5 0 0 0.25\n-0.5 0 0 0.25\n0.5 0 0 0.25\n1.5 0 0 0.25\n"));
         EXPECT_NEAR(depth_at(*scene, 0.3f), 5 - 1.25f, 1e-4f) << type;
         EXPECT_NEAR(depth_at(*scene, 0.8f), 5 - 1.25f, 1e-4f) << type;  // the B-spline ends at x = 0.5 unstretched
-        EXPECT_EQ(scene->shapes()[0]->kind, Shape::Kind::Curve);
+        EXPECT_NE(dynamic_cast<const CurveShape *>(scene->shapes()[0].get()), nullptr);
         EXPECT_EQ(scene->triangle_count(), 0u);
     }
 }

@@ -7,7 +7,7 @@
 #include <fstream>
 #include "common/volume_grid_writer.h"
 #include "neepp/io/scene_error.h"
-#include "neepp/scene/sdf_grid.h"
+#include "neepp/shapes/sdf_grid_shape.h"
 #include "test_scenes.h"
 
 using namespace neepp;
@@ -46,10 +46,9 @@ TEST(SdfGridShape, TheGridNormalsAndToWorldReachTheShape) {
            <transform name="to_world"><scale value="2"/><translate x="-1" y="-1" z="-1"/></transform></shape>)",
                                        neepp::testing::sphere_sdf_grid(21)));
     ASSERT_EQ(scene->shapes().size(), 1u);
-    const Shape &s = *scene->shapes()[0];
-    ASSERT_EQ(s.kind, Shape::Kind::SdfGrid);
-    EXPECT_EQ(s.sdf_grid->size(0), 21u);
-    EXPECT_EQ(s.sdf_grid->normals(), SdfGrid::Normals::Analytic);
+    const auto &s = dynamic_cast<const SdfGridShape &>(*scene->shapes()[0]);
+    EXPECT_EQ(s.grid->size(0), 21u);
+    EXPECT_EQ(s.grid->normals(), SdfGrid::Normals::Analytic);
     // [0, 1]^3 scaled by 2 and moved to [-1, 1]^3, the sphere of radius 0.3 with it: 0.6 about the origin.
     EXPECT_EQ(s.bounds().lo, Vec3(-1.f));
     EXPECT_EQ(s.bounds().hi, Vec3(1.f));
@@ -62,7 +61,7 @@ TEST(SdfGridShape, TheGridNormalsAndToWorldReachTheShape) {
     // Smooth normals are the default.
     auto plain = load_scene(scene_with(std::string(R"(<shape type="sdfgrid">)") + kGridFile + "</shape>",
                                        neepp::testing::sphere_sdf_grid(21)));
-    EXPECT_EQ(plain->shapes()[0]->sdf_grid->normals(), SdfGrid::Normals::Smooth);
+    EXPECT_EQ(dynamic_cast<const SdfGridShape &>(*plain->shapes()[0]).grid->normals(), SdfGrid::Normals::Smooth);
 }
 
 TEST(SdfGridShape, AnInstanceMovesTheGridAfterItsOwnToWorld) {
@@ -74,7 +73,8 @@ TEST(SdfGridShape, AnInstanceMovesTheGridAfterItsOwnToWorld) {
            <shape type="instance"><ref id="g"/><transform name="to_world"><rotate y="1" angle="90"/></transform></shape>)",
                                        neepp::testing::sphere_sdf_grid(21)));
     ASSERT_EQ(scene->shapes().size(), 2u);
-    EXPECT_EQ(scene->shapes()[0]->sdf_grid, scene->shapes()[1]->sdf_grid);
+    EXPECT_EQ(dynamic_cast<const SdfGridShape &>(*scene->shapes()[0]).grid,
+              dynamic_cast<const SdfGridShape &>(*scene->shapes()[1]).grid);
     SurfaceInteraction si;
     ASSERT_TRUE(scene->intersect(Ray{{3, 1, 5}, {0, 0, -1}}, si));
     EXPECT_EQ(si.shape, scene->shapes()[0].get());

@@ -4,6 +4,7 @@
 #include <filesystem>
 #include <fstream>
 #include "common/serialized_writer.h"
+#include "neepp/shapes/triangle_mesh.h"
 #include "neepp/io/scene_error.h"
 #include "test_scenes.h"
 
@@ -37,18 +38,19 @@ TEST(SerializedShape, ShapeIndexToWorldAndNormalsReachTheMesh) {
         R"(<string name="filename" value="meshes.serialized"/><integer name="shape_index" value="1"/>
            <transform name="to_world"><scale value="2"/><translate x="1"/></transform>)", file));
     ASSERT_EQ(scene->shapes().size(), 1u);
-    const Shape &s = *scene->shapes()[0];
+    const auto &s = dynamic_cast<const TriangleMesh &>(*scene->shapes()[0]);
     ASSERT_EQ(s.positions.size(), 3u);
     EXPECT_EQ(s.positions[1], Vec3(3, 0, 2));  // (1, 0, 1) scaled by 2, moved by 1 in x
     ASSERT_EQ(s.normals.size(), 3u);
     EXPECT_EQ(s.normals[0], Vec3(0, 0, 1));
     // The first mesh has none: they are computed, unless face_normals asks for none.
     auto first = load_scene(scene_with_serialized(R"(<string name="filename" value="meshes.serialized"/>)", file));
-    EXPECT_EQ(first->shapes()[0]->normals.size(), 3u);
+    EXPECT_EQ(dynamic_cast<const TriangleMesh &>(*first->shapes()[0]).normals.size(), 3u);
     auto faceted = load_scene(scene_with_serialized(
         R"(<string name="filename" value="meshes.serialized"/><boolean name="face_normals" value="true"/>)", file));
-    EXPECT_TRUE(faceted->shapes()[0]->face_normals);
-    EXPECT_TRUE(faceted->shapes()[0]->normals.empty());
+    const auto &faceted_mesh = dynamic_cast<const TriangleMesh &>(*faceted->shapes()[0]);
+    EXPECT_TRUE(faceted_mesh.face_normals);
+    EXPECT_TRUE(faceted_mesh.normals.empty());
 }
 
 TEST(SerializedShape, ABadFileNamesTheSceneLineAndTheFile) {

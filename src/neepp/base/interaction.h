@@ -8,7 +8,7 @@ namespace neepp {
 
 class BSDF;
 class Light;
-struct Shape;
+class Shape;
 
 // Mitsuba 3's offsets (math::RayEpsilon and ShadowEpsilon), larger than float precision alone needs:
 // scenes made for Mitsuba are modelled around them. Bathroom's light bulbs are two glass shells 6e-5

@@ -1,6 +1,7 @@
 #include "neepp/lights/area_light.h"
 
 #include "neepp/math/warp.h"
+#include "neepp/shapes/triangle_mesh.h"
 
 namespace neepp {
 
@@ -30,9 +31,10 @@ DirectionSample AreaLight::sample_direction(const Vec3 &ref, Vec2 u, Color &radi
 void AreaLight::prepare(const BBox &) {
     lane_record_ = nullptr;
     // A parallelogram's sample needs no triangle choice, and with constant radiance no uv: the lane
-    // kernel's case. Its shading normal is its face's (Shape::find_parallelogram checks vertex normals).
-    const std::optional<Shape::Parallelogram> &q = shape_->parallelogram();
-    if (!LightSampleLanes::kEnabled || !constant_ || !q || shape_->kind != Shape::Kind::Mesh) return;
+    // kernel's case. Its shading normal is its face's (TriangleMesh::find_parallelogram checks vertex normals).
+    const auto *mesh = dynamic_cast<const TriangleMesh *>(shape_);
+    if (!LightSampleLanes::kEnabled || !constant_ || !mesh || !mesh->parallelogram()) return;
+    const TriangleMesh::Parallelogram *q = &*mesh->parallelogram();
     lane_.p0 = q->p0, lane_.e1 = q->e1, lane_.e2 = q->e2, lane_.n = q->n;
     lane_.pdf = shape_->pdf_position();
     lane_.radiance = constant_radiance_;
@@ -78,42 +80,12 @@ Color AreaLight::eval_surface(const SurfaceInteraction &si, const Vec3 &w) const
     return dot(si.sh_frame.n, w) > 0 ? radiance_->eval(si) : Color(0.f);
 }
 
-}  // namespace neepp
-
-namespace neepp {
-
 std::optional<LightBounds> AreaLight::bounds() const {
     LightBounds b;
     b.bounds = shape_->bounds();
     b.phi = luminance(power());
     b.cos_theta_e = 0.f;  // cosine emission: nothing beyond 90 degrees from the normal
-    if (shape_->kind == Shape::Kind::Sphere) {
-        b.normals = DirectionCone::entire_sphere();
-        return b;
-    }
-    // Union of the face normals and the vertex normals (flipped if asked): the shading normals, which
-    // decide the emission side, lie between a face's vertex normals.
-    bool first = true;
-    auto add = [&](const DirectionCone &c) {
-        b.normals = first ? c : cone_union(b.normals, c);
-        first = false;
-    };
-    if (!shape_->face_normals)
-        for (const Vec3 &vn : shape_->normals) {
-            const float len = norm(vn);
-            if (len > 0) add(DirectionCone{(shape_->flip_normals ? -vn : vn) / len, 1.f});
-            if (b.normals.is_entire_sphere()) return b;
-        }
-    for (size_t t = 0; t < shape_->triangle_count(); ++t) {
-        const Vec3 &p0 = shape_->positions[shape_->indices[3 * t]];
-        const Vec3 &p1 = shape_->positions[shape_->indices[3 * t + 1]];
-        const Vec3 &p2 = shape_->positions[shape_->indices[3 * t + 2]];
-        Vec3 c = cross(p1 - p0, p2 - p0);
-        float len = norm(c);
-        if (!(len > 0)) continue;  // degenerate: zero area, never sampled
-        add(DirectionCone{(shape_->flip_normals ? -c : c) / len, 1.f});
-        if (b.normals.is_entire_sphere()) break;
-    }
+    b.normals = shape_->normal_bounds();
     return b;
 }
 

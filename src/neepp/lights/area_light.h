@@ -5,7 +5,7 @@
 #include "neepp/base/light.h"
 #include "neepp/base/texture.h"
 #include "neepp/lights/light_lanes.h"
-#include "neepp/scene/shape.h"
+#include "neepp/base/shape.h"
 
 namespace neepp {
 
@@ -24,7 +24,7 @@ public:
     EmissionSample sample_emission(Vec2 u_pos, Vec2 u_dir) const override;
     EmissionDensity pdf_emission(const Vec3 &p, const Vec3 &n, const Vec3 &ns, const Vec3 &w) const override;
     Color power() const override { return radiance_->mean() * (kPi * shape_->surface_area()); }
-    // The shape's box, a cone around its face and vertex normals, one-sided cosine emission.
+    // The shape's box, its normal bounds, one-sided cosine emission.
     std::optional<LightBounds> bounds() const override;
     const Shape *shape() const { return shape_; }
     // A parallelogram of constant radiance is sampled in lanes too (lane_record()).

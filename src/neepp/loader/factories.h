@@ -32,7 +32,7 @@ private:
     std::unique_ptr<Shape> build_shape(const XmlNode &node, const XmlNode *&emitter_node);
     // A shapegroup's shapes (each in its own to_world), built at the first use and shared by every
     // instance of the group (loader/instances.cpp).
-    const std::vector<Shape> &shape_group(const XmlNode &node);
+    const std::vector<std::unique_ptr<Shape>> &shape_group(const XmlNode &node);
     void instance(const XmlNode &node, Scene &scene);
     BSDFPtr create_bsdf(const XmlNode &node);
     TexturePtr principled_lobe_param(const XmlNode &node, const std::string &name);
@@ -44,7 +44,7 @@ private:
     // Nested BSDFs each built BSDF evaluates per shading point (Factories::bsdf), and their bound.
     static constexpr int kMaxBsdfEvaluations = 64;
     std::map<const XmlNode *, int> bsdf_cost_;
-    std::map<const XmlNode *, std::vector<Shape>> shape_groups_;
+    std::map<const XmlNode *, std::vector<std::unique_ptr<Shape>>> shape_groups_;
     BSDFPtr default_bsdf_, black_bsdf_;
 };
 
@@ -63,9 +63,6 @@ template <typename F> auto located_at(const XmlNode &node, F &&f) -> decltype(f(
 // that renders the same image (prb, volpath without media, direct, ptracer, the moment wrapper), said
 // in one line on stderr.
 void load_integrator(const XmlNode &node, RenderSettings &settings);
-// Moves a shape (a mesh or a sphere) by to_world, its normals with it; throws std::runtime_error when
-// the result is not finite, or when it would make a sphere an ellipsoid.
-void transform_shape(Shape &s, const Transform &to_world);
 // Throws, naming the shape, when a mesh_attribute texture under bsdf_node reads an attribute the shape
 // lacks (Mitsuba fails at render time; here it fails at load).
 void check_mesh_attributes(const XmlNode &bsdf_node, const Shape &shape, const XmlNode &shape_node);

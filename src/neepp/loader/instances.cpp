@@ -7,9 +7,9 @@
 
 namespace neepp::loader {
 
-const std::vector<Shape> &Factories::shape_group(const XmlNode &node) {
+const std::vector<std::unique_ptr<Shape>> &Factories::shape_group(const XmlNode &node) {
     if (auto it = shape_groups_.find(&node); it != shape_groups_.end()) return it->second;
-    std::vector<Shape> shapes;
+    std::vector<std::unique_ptr<Shape>> shapes;
     for (const auto &child : node.children) attempt([&] {  // when checking, a broken member is left out
         // What Mitsuba's ShapeGroup refuses.
         if (child->tag != "shape") throw child->error("a shapegroup holds only shapes, not <" + child->tag + ">");
@@ -18,7 +18,7 @@ const std::vector<Shape> &Factories::shape_group(const XmlNode &node) {
         const XmlNode *emitter_node = nullptr;
         std::unique_ptr<Shape> s = build_shape(*child, emitter_node);
         if (emitter_node) throw emitter_node->error("a shape in a shapegroup cannot carry an emitter (emitters are not instanced)");
-        shapes.push_back(std::move(*s));
+        shapes.push_back(std::move(s));
     });
     warn_unused(node);
     return shape_groups_[&node] = std::move(shapes);
@@ -36,10 +36,10 @@ void Factories::instance(const XmlNode &node, Scene &scene) {
     if (!group) throw node.error("an instance needs a <ref> to a shapegroup");
     const Transform to_world = node.get_transform("to_world");
     warn_unused(node);
-    for (const Shape &prototype : shape_group(*group)) {
-        auto s = std::make_unique<Shape>(prototype);
+    for (const auto &prototype : shape_group(*group)) {
+        std::unique_ptr<Shape> s = prototype->clone();
         try {
-            transform_shape(*s, to_world);
+            s->transform(to_world);
         } catch (const std::exception &e) {
             throw node.error(e.what());
         }

@@ -16,7 +16,10 @@
 #include "neepp/loader/plugins.h"
 #include "neepp/loader/problems.h"
 #include "neepp/textures/bitmap_texture.h"
-#include "neepp/scene/sdf_grid.h"
+#include "neepp/shapes/curve_shape.h"
+#include "neepp/shapes/sdf_grid_shape.h"
+#include "neepp/shapes/sphere.h"
+#include "neepp/shapes/triangle_mesh.h"
 
 namespace neepp::loader {
 namespace {
@@ -145,7 +148,7 @@ std::shared_ptr<const SdfGrid> load_sdf_grid(const XmlNode &node) {
 
 // Smooth vertex normals for meshes that have none, weighting each face by its angle at the vertex
 // (Mitsuba's recompute_vertex_normals).
-void compute_vertex_normals(Shape &s) {
+void compute_vertex_normals(TriangleMesh &s) {
     s.normals.assign(s.positions.size(), Vec3(0.f));
     for (size_t t = 0; t < s.triangle_count(); ++t) {
         uint32_t idx[3] = {s.indices[3 * t], s.indices[3 * t + 1], s.indices[3 * t + 2]};
@@ -168,90 +171,31 @@ void compute_vertex_normals(Shape &s) {
     }
 }
 
-// The scale of a to_world that scales all directions alike (it may also translate, rotate and mirror);
-// throws, naming it (what), for one that shears or scales some directions more than others.
-float uniform_scale(const Transform &to_world, const std::string &what) {
-    Vec3 axes[3];
-    float scale[3];
-    for (int i = 0; i < 3; ++i) {
-        axes[i] = to_world.vector(Vec3(i == 0, i == 1, i == 2));
-        scale[i] = norm(axes[i]);
-    }
-    const float tol = 1e-4f * scale[0] * scale[0];
-    if (std::abs(scale[1] - scale[0]) > 1e-4f * scale[0] || std::abs(scale[2] - scale[0]) > 1e-4f * scale[0] ||
-        std::abs(dot(axes[0], axes[1])) > tol || std::abs(dot(axes[0], axes[2])) > tol || std::abs(dot(axes[1], axes[2])) > tol)
-        throw std::runtime_error(what + " must scale uniformly (and not shear)");
-    return scale[0];
-}
-
 // Mitsuba's `linearcurve` and `bsplinecurve`: the file's control points moved by to_world, their radii
 // as written (Mitsuba's to_world does not scale them).
-void set_curves(Shape &s, CurveBasis basis, CurveData curves, const Transform &to_world) {
-    s.kind = Shape::Kind::Curve;
-    s.curve_basis = basis;
-    s.curve_points.resize(curves.points.size());
+std::unique_ptr<CurveShape> make_curves(CurveBasis basis, CurveData curves, const Transform &to_world) {
+    auto s = std::make_unique<CurveShape>();
+    s->basis = basis;
+    s->points.resize(curves.points.size());
     for (size_t i = 0; i < curves.points.size(); ++i) {
-        s.curve_points[i] = {to_world.point(curves.points[i]), curves.radii[i]};
-        if (!is_finite(s.curve_points[i].p)) throw std::runtime_error("the transformed curve has non-finite control points");
+        s->points[i] = {to_world.point(curves.points[i]), curves.radii[i]};
+        if (!is_finite(s->points[i].p)) throw std::runtime_error("the transformed curve has non-finite control points");
     }
-    s.curve_segments = std::move(curves.segments);
+    s->segments = std::move(curves.segments);
+    return s;
 }
 
-}  // namespace
-
-// Moves the shape by `to_world`: a mesh's vertex normals keep their direction relative to the surface
-// (the inverse transpose, renormalized). A to_world on a sphere or on curves (an instance's: this is not
-// where a curve shape's own to_world is applied, which leaves radii alone) may translate, rotate, mirror
-// and scale uniformly, a sphere's axes turning with it and radii scaling with it (Mitsuba allows more;
-// neepp refuses). An SDF grid takes any affine to_world: rays go to its space.
-void transform_shape(Shape &s, const Transform &to_world) {
-    if (s.kind == Shape::Kind::SdfGrid) {
-        s.sdf_to_world = to_world * s.sdf_to_world;
-        for (const auto &row : s.sdf_to_world.matrix.m)
-            for (float v : row)
-                if (!std::isfinite(v)) throw std::runtime_error("the sdfgrid's to_world is not finite");
-        return;
-    }
-    if (s.kind == Shape::Kind::Sphere) {
-        const float scale = uniform_scale(to_world, "sphere to_world");
-        s.center = to_world.point(s.center);
-        s.radius *= scale;
-        if (!(s.radius > 0) || !std::isfinite(s.radius) || !is_finite(s.center))
-            throw std::runtime_error("sphere needs a positive radius and a finite center");
-        for (Vec3 &axis : s.sphere_axes) axis = normalize(to_world.vector(axis));
-        return;
-    }
-    if (s.kind == Shape::Kind::Curve) {
-        const float scale = uniform_scale(to_world, "the to_world of an instance of curves");
-        for (CurvePoint &cp : s.curve_points) {
-            cp.p = to_world.point(cp.p);
-            cp.radius *= scale;
-            if (!is_finite(cp.p) || !std::isfinite(cp.radius))
-                throw std::runtime_error("the transformed curve has non-finite control points");
-        }
-        return;
-    }
-    for (Vec3 &p : s.positions) {
-        p = to_world.point(p);
-        if (!is_finite(p)) throw std::runtime_error("the transformed mesh has non-finite vertices");
-    }
-    for (Vec3 &n : s.normals) {
-        n = to_world.normal(n);
-        const float len = norm(n);
-        if (len > 0) n = n / len;
-    }
-}
-
-namespace {
-
-void set_mesh(Shape &s, MeshData mesh, const Transform &to_world) {
-    s.positions = std::move(mesh.positions);
-    s.normals = std::move(mesh.normals);
-    s.uvs = std::move(mesh.uvs);
-    s.indices = std::move(mesh.indices);
-    if (!mesh.attributes.empty()) s.attributes = std::make_shared<const std::vector<MeshAttribute>>(std::move(mesh.attributes));
-    transform_shape(s, to_world);
-    if (!s.face_normals && s.normals.empty()) compute_vertex_normals(s);
+std::unique_ptr<TriangleMesh> make_mesh(MeshData mesh, const Transform &to_world, bool face_normals) {
+    auto s = std::make_unique<TriangleMesh>();
+    s->face_normals = face_normals;
+    s->positions = std::move(mesh.positions);
+    s->normals = std::move(mesh.normals);
+    s->uvs = std::move(mesh.uvs);
+    s->indices = std::move(mesh.indices);
+    if (!mesh.attributes.empty()) s->attributes = std::make_shared<const std::vector<MeshAttribute>>(std::move(mesh.attributes));
+    s->transform(to_world);
+    if (!s->face_normals && s->normals.empty()) compute_vertex_normals(*s);
+    return s;
 }
 
 // A registered shape's mesh is checked as a mesh file's is: indices in range and by threes, one normal
@@ -270,11 +214,12 @@ void check_mesh(const MeshData &m, const XmlNode &node) {
 // Whether the shape has a surface: a mesh with no triangles, or only degenerate ones (a scale of 0,
 // collinear vertices), has none, and an emitter on it would be a light of zero area, which neither
 // light sampling nor emission sampling can sample a point of.
-bool has_surface(const Shape &s) {
-    if (s.kind != Shape::Kind::Mesh) return true;
-    for (size_t t = 0; t + 2 < s.indices.size(); t += 3) {
-        const Vec3 &a = s.positions[s.indices[t]];
-        if (norm(cross(s.positions[s.indices[t + 1]] - a, s.positions[s.indices[t + 2]] - a)) > 0) return true;
+bool has_surface(const Shape &shape) {
+    const auto *s = dynamic_cast<const TriangleMesh *>(&shape);
+    if (!s) return true;
+    for (size_t t = 0; t + 2 < s->indices.size(); t += 3) {
+        const Vec3 &a = s->positions[s->indices[t]];
+        if (norm(cross(s->positions[s->indices[t + 1]] - a, s->positions[s->indices[t + 2]] - a)) > 0) return true;
     }
     return false;
 }
@@ -295,11 +240,11 @@ void Factories::shape(const XmlNode &node, Scene &scene) {
     Shape *shape = s.get();
     scene.add_shape(std::move(s));
     if (emitter_node) attempt([&] {
-        if (shape->kind == Shape::Kind::Curve)  // Mitsuba loads it, then fails at the first render
+        if (dynamic_cast<const CurveShape *>(shape))  // Mitsuba loads it, then fails at the first render
             throw emitter_node->error("a " + node.type + " cannot carry an emitter (curves have no surface area "
                                       "to sample a point of; Mitsuba 3 cannot render one either)");
         if (emitter_node->type != "area") throw emitter_node->error("a shape can only carry an 'area' emitter");
-        if (shape->kind == Shape::Kind::SdfGrid)
+        if (dynamic_cast<const SdfGridShape *>(shape))
             throw emitter_node->error("an sdfgrid cannot carry an area emitter (Mitsuba 3's sdfgrid cannot be an emitter)");
         TexturePtr radiance = texture_param(*emitter_node, "radiance", Color(1.f));
         warn_unused(*emitter_node);
@@ -313,15 +258,15 @@ void Factories::shape(const XmlNode &node, Scene &scene) {
 }
 
 std::unique_ptr<Shape> Factories::build_shape(const XmlNode &node, const XmlNode *&emitter_node) {
-    auto s = std::make_unique<Shape>();
-    s->id = node.id;
     const std::string &t = node.type;
     // Mitsuba's sdfgrid and curves have neither option: left unread, either is reported as unused.
+    bool face_normals = false, flip_normals = false;
     if (t != "sdfgrid" && t != "linearcurve" && t != "bsplinecurve") {
-        s->face_normals = node.get_bool("face_normals", false);
-        s->flip_normals = node.get_bool("flip_normals", false);
+        face_normals = node.get_bool("face_normals", false);
+        flip_normals = node.get_bool("flip_normals", false);
     }
     Transform to_world = node.get_transform("to_world");
+    std::unique_ptr<Shape> s;
     try {
         if (t == "obj" || t == "ply" || t == "serialized") {
             std::string path = node.resolve_path(node.get_string("filename"));
@@ -332,7 +277,7 @@ std::unique_ptr<Shape> Factories::build_shape(const XmlNode &node, const XmlNode
             } catch (const std::exception &e) {  // the mesh's own error, located at the shape using it
                 throw node.error(e.what());
             }
-            set_mesh(*s, std::move(mesh), to_world);
+            s = make_mesh(std::move(mesh), to_world, face_normals);
         } else if (t == "linearcurve" || t == "bsplinecurve") {
             const CurveBasis basis = t == "linearcurve" ? CurveBasis::Linear : CurveBasis::BSpline;
             const std::string path = node.resolve_path(node.get_string("filename"));
@@ -342,29 +287,31 @@ std::unique_ptr<Shape> Factories::build_shape(const XmlNode &node, const XmlNode
             } catch (const std::exception &e) {  // the file's own error, located at the shape using it
                 throw node.error(e.what());
             }
-            set_curves(*s, basis, std::move(curves), to_world);
+            s = make_curves(basis, std::move(curves), to_world);
         } else if (t == "rectangle") {
-            set_mesh(*s, rectangle_mesh(), to_world);
+            s = make_mesh(rectangle_mesh(), to_world, face_normals);
         } else if (t == "cube") {
-            set_mesh(*s, cube_mesh(), to_world);
+            s = make_mesh(cube_mesh(), to_world, face_normals);
         } else if (t == "disk") {
-            set_mesh(*s, disk_mesh(), to_world);
+            s = make_mesh(disk_mesh(), to_world, face_normals);
         } else if (t == "cylinder") {
-            set_mesh(*s, cylinder_mesh(), to_world * cylinder_frame(node));
+            s = make_mesh(cylinder_mesh(), to_world * cylinder_frame(node), face_normals);
         } else if (t == "sphere") {
-            s->kind = Shape::Kind::Sphere;
-            s->center = node.get_vector("center", Vec3(0.f));
-            s->radius = node.get_float("radius", 1.f);
-            if (!(s->radius > 0) || !std::isfinite(s->radius)) throw node.error("sphere radius must be positive and finite");
-            transform_shape(*s, to_world);
+            auto sphere = std::make_unique<Sphere>();
+            sphere->center = node.get_vector("center", Vec3(0.f));
+            sphere->radius = node.get_float("radius", 1.f);
+            if (!(sphere->radius > 0) || !std::isfinite(sphere->radius)) throw node.error("sphere radius must be positive and finite");
+            sphere->transform(to_world);
+            s = std::move(sphere);
         } else if (t == "sdfgrid") {
-            s->kind = Shape::Kind::SdfGrid;
-            s->sdf_grid = load_sdf_grid(node);
-            transform_shape(*s, to_world);
+            auto grid = std::make_unique<SdfGridShape>();
+            grid->grid = load_sdf_grid(node);
+            grid->transform(to_world);
+            s = std::move(grid);
         } else if (const ShapePlugin *plugin = find_shape_plugin(t)) {
             MeshData mesh = (*plugin)(PluginProperties(node, *this));
             check_mesh(mesh, node);
-            set_mesh(*s, std::move(mesh), to_world);
+            s = make_mesh(std::move(mesh), to_world, face_normals);
         } else {
             throw node.error("unsupported shape type '" + t + "' (supported: " + supported_list("shape") + ")");
         }
@@ -373,6 +320,8 @@ std::unique_ptr<Shape> Factories::build_shape(const XmlNode &node, const XmlNode
     } catch (const std::exception &e) {
         throw node.error(e.what());
     }
+    s->id = node.id;
+    s->flip_normals = flip_normals;
 
     emitter_node = nullptr;
     for (const auto &child : node.children) {

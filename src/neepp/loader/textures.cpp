@@ -7,6 +7,7 @@
 #include "neepp/loader/problems.h"
 #include "neepp/textures/bitmap_texture.h"
 #include "neepp/textures/checkerboard_texture.h"
+#include "neepp/shapes/triangle_mesh.h"
 #include "neepp/textures/mesh_attribute_texture.h"
 
 namespace neepp::loader {
@@ -76,10 +77,11 @@ void check_mesh_attributes(const XmlNode &bsdf_node, const Shape &shape, const X
             if (!seen.insert(child.get()).second) continue;
             if (child->tag == "texture" && child->type == "mesh_attribute") {
                 const std::string name = child->get_string("name");
-                if (!shape.attribute(name)) {
+                const auto *mesh = dynamic_cast<const TriangleMesh *>(&shape);
+                if (!mesh || !mesh->attribute(name)) {
                     std::string have;
-                    if (shape.attributes)
-                        for (const MeshAttribute &a : *shape.attributes) have += (have.empty() ? "" : ", ") + a.name;
+                    if (mesh && mesh->attributes)
+                        for (const MeshAttribute &a : *mesh->attributes) have += (have.empty() ? "" : ", ") + a.name;
                     throw shape_node.error("has no mesh attribute \"" + name + "\" (read by the mesh_attribute texture at " +
                                            child->file + ":" + std::to_string(child->line) + "); it has " +
                                            (have.empty() ? std::string("none") : have));

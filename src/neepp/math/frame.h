@@ -21,6 +21,17 @@ struct Frame {
 };
 
 // Trigonometric helpers on local-frame directions (z = cos theta).
+// The shading frame around n with s along dp/du made perpendicular to n (Gram-Schmidt), as Mitsuba aligns
+// it, so anisotropic and bump-mapped materials have a consistent tangent; around n alone where dp/du has
+// no part across n.
+[[gnu::always_inline]] inline Frame frame_along(const Vec3 &n, const Vec3 &dpdu) {
+    Vec3 s = dpdu - n * dot(n, dpdu);
+    const float s2 = squared_norm(s);
+    if (!(s2 > 1e-20f && std::isfinite(s2))) return Frame(n);
+    s = s / std::sqrt(s2);
+    return Frame(s, cross(n, s), n);
+}
+
 inline float cos_theta(const Vec3 &w) { return w.z; }
 inline float abs_cos_theta(const Vec3 &w) { return std::abs(w.z); }
 inline float cos2_theta(const Vec3 &w) { return w.z * w.z; }

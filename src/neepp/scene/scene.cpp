@@ -8,7 +8,6 @@
 #include <type_traits>
 
 #include "neepp/math/transpose.h"
-#include "neepp/scene/embree_sdf_grid.h"
 
 namespace neepp {
 namespace {
@@ -16,20 +15,6 @@ namespace {
 // Embree calls this from C code, so it must not throw; build() checks the device error afterwards.
 void embree_error(void *, RTCError code, const char *message) {
     std::fprintf(stderr, "Embree error %d: %s\n", int(code), message ? message : "");
-}
-
-// Mitsuba's curves cull back faces: no hit from inside a tube, so a ray leaving a curve's surface (or
-// starting inside it) passes out of it unhit. Mitsuba builds Embree with that culling compiled in
-// (EMBREE_BACKFACE_CULLING_CURVES); a system Embree may lack it, so this filter rejects every hit whose
-// ray runs along the surface's outward normal. Where the culling is compiled in, it never sees one.
-void cull_curve_back_faces(const RTCFilterFunctionNArguments *args) {
-    for (unsigned i = 0; i < args->N; ++i) {
-        if (args->valid[i] == 0) continue;
-        const float along = RTCRayN_dir_x(args->ray, args->N, i) * RTCHitN_Ng_x(args->hit, args->N, i) +
-                            RTCRayN_dir_y(args->ray, args->N, i) * RTCHitN_Ng_y(args->hit, args->N, i) +
-                            RTCRayN_dir_z(args->ray, args->N, i) * RTCHitN_Ng_z(args->hit, args->N, i);
-        if (along > 0) args->valid[i] = 0;
-    }
 }
 
 // Embree's ray for ours: no motion time, every mask bit, no flags.
@@ -195,43 +180,13 @@ void Scene::build() {
     rtc_scene_ = rtcNewScene(device_);
     rtcSetSceneBuildQuality(rtc_scene_, RTC_BUILD_QUALITY_HIGH);
     bounds_ = BBox();
+    meshes_.assign(shapes_.size(), nullptr);
     for (size_t i = 0; i < shapes_.size(); ++i) {
         Shape &s = *shapes_[i];
         s.finalize();
-        RTCGeometry geom;
-        if (s.kind == Shape::Kind::Sphere) {
-            geom = rtcNewGeometry(device_, RTC_GEOMETRY_TYPE_SPHERE_POINT);
-            float *v = (float *)rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT4,
-                                                        4 * sizeof(float), 1);
-            v[0] = s.center.x; v[1] = s.center.y; v[2] = s.center.z; v[3] = s.radius;
-        } else if (s.kind == Shape::Kind::SdfGrid) {
-            geom = new_sdf_grid_geometry(device_, s);
-        } else if (s.kind == Shape::Kind::Curve) {
-            // Embree's round curves, set up as Mitsuba sets them up (no neighbour flags): linear segments are
-            // cones joined and ended by spheres, B-spline ones a sweep of spheres with open ends; back faces
-            // culled as Mitsuba culls them.
-            geom = rtcNewGeometry(device_, s.curve_basis == CurveBasis::Linear ? RTC_GEOMETRY_TYPE_ROUND_LINEAR_CURVE
-                                                                               : RTC_GEOMETRY_TYPE_ROUND_BSPLINE_CURVE);
-            auto *v = (CurvePoint *)rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT4,
-                                                            sizeof(CurvePoint), s.curve_points.size());
-            std::copy(s.curve_points.begin(), s.curve_points.end(), v);
-            auto *idx = (uint32_t *)rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT,
-                                                            sizeof(uint32_t), s.curve_segments.size());
-            std::copy(s.curve_segments.begin(), s.curve_segments.end(), idx);
-            rtcSetGeometryIntersectFilterFunction(geom, cull_curve_back_faces);
-            rtcSetGeometryOccludedFilterFunction(geom, cull_curve_back_faces);
-        } else {
-            if (s.indices.empty()) continue;  // nothing to intersect; kept so ids stay stable
-            geom = rtcNewGeometry(device_, RTC_GEOMETRY_TYPE_TRIANGLE);
-            float *v = (float *)rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3,
-                                                        3 * sizeof(float), s.positions.size());
-            for (size_t k = 0; k < s.positions.size(); ++k) {
-                v[3 * k] = s.positions[k].x; v[3 * k + 1] = s.positions[k].y; v[3 * k + 2] = s.positions[k].z;
-            }
-            uint32_t *idx = (uint32_t *)rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
-                                                                3 * sizeof(uint32_t), s.triangle_count());
-            std::copy(s.indices.begin(), s.indices.end(), idx);
-        }
+        meshes_[i] = dynamic_cast<const TriangleMesh *>(&s);
+        RTCGeometry geom = s.embree_geometry(device_);
+        if (!geom) continue;  // nothing to intersect; kept so ids stay stable
         rtcCommitGeometry(geom);
         rtcAttachGeometryByID(rtc_scene_, geom, unsigned(i));
         rtcReleaseGeometry(geom);

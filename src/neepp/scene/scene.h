@@ -7,8 +7,9 @@
 #include <embree3/rtcore.h>
 #include "neepp/base/light.h"
 #include "neepp/scene/camera.h"
-#include "neepp/scene/hit_lanes.h"
-#include "neepp/scene/shape.h"
+#include "neepp/base/shape.h"
+#include "neepp/shapes/hit_lanes.h"
+#include "neepp/shapes/triangle_mesh.h"
 
 namespace neepp {
 
@@ -26,7 +27,7 @@ struct RenderSettings {
 
 // What Embree reports for a ray before the hit record is filled in. Kept apart so that a batch of paths
 // can trace all its rays first and fill their hit records after the triangle data those need has been
-// prefetched (Shape::prefetch).
+// prefetched (TriangleMesh::prefetch).
 struct RayHit {
     static constexpr uint32_t kNone = ~0u;
     float t = kInfinity, u = 0, v = 0;
@@ -55,17 +56,19 @@ public:
     void trace16(const Ray *const *rays, RayHit *const *hits, int n, bool coherent = false) const;
     // Prefetches what fill() will read for hit (its triangle's record). A hint: no effect on results.
     void prefetch(const RayHit &hit) const {
-        if (hit.valid()) shapes_[hit.geom]->prefetch(hit.prim);
+        if (!hit.valid()) return;
+        if (const TriangleMesh *mesh = meshes_[hit.geom]) mesh->prefetch(hit.prim);
     }
     void fill(const RayHit &hit, const Ray &ray, SurfaceInteraction &si) const {
-        shapes_[hit.geom]->fill_interaction(hit.prim, hit.u, hit.v, ray, hit.t, si);
+        if (const TriangleMesh *mesh = meshes_[hit.geom]) mesh->fill_interaction(hit.prim, hit.u, hit.v, ray, hit.t, si);
+        else shapes_[hit.geom]->fill_interaction(hit.prim, hit.u, hit.v, ray, hit.t, si);
         si.wi = si.to_local(-ray.d);
     }
     // fill(), or, for a hit that can be, queued in lanes to be filled with seven others (HitLanes):
     // si is complete after the eighth, or fill_lanes.
     void fill_in_lanes(HitLanes &lanes, const RayHit &hit, const Ray &ray, SurfaceInteraction &si) const {
-        const Shape &s = *shapes_[hit.geom];
-        if (s.fills_in_lanes()) add_lane(lanes, s, hit.prim, hit.u, hit.v, hit.t, ray.d, si);
+        const TriangleMesh *mesh = meshes_[hit.geom];
+        if (mesh && mesh->fills_in_lanes()) add_lane(lanes, *mesh, hit.prim, hit.u, hit.v, hit.t, ray.d, si);
         else fill(hit, ray, si);
     }
     bool occluded(const Ray &ray) const;
@@ -93,6 +96,9 @@ private:
     RTCScene rtc_scene_ = nullptr;
     int packet_width_ = 16;
     std::vector<std::unique_ptr<Shape>> shapes_;
+    // shapes_[i] where it is a triangle mesh, else null: the fast form's hits on meshes (most hits) are
+    // prefetched, filled in lanes and filled without a virtual call.
+    std::vector<const TriangleMesh *> meshes_;
     std::vector<LightPtr> lights_;
     std::vector<const Light *> infinite_lights_;
     BBox bounds_;

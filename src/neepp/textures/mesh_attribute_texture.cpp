@@ -1,7 +1,7 @@
 #include "neepp/textures/mesh_attribute_texture.h"
 
 #include <stdexcept>
-#include "neepp/scene/shape.h"
+#include "neepp/shapes/triangle_mesh.h"
 
 namespace neepp {
 
@@ -20,15 +20,16 @@ Color components(const MeshAttribute &a, size_t index) {
 }  // namespace
 
 Color MeshAttributeTexture::eval(const SurfaceInteraction &si) const {
-    // The loader checks that every shape this texture is used on has the attribute.
-    const MeshAttribute *a = si.shape ? si.shape->attribute(name_) : nullptr;
+    // The loader checks that every shape this texture is used on is a mesh with the attribute.
+    const auto *mesh = dynamic_cast<const TriangleMesh *>(si.shape);
+    const MeshAttribute *a = mesh ? mesh->attribute(name_) : nullptr;
     if (!a) return Color(0.f);
     const size_t tri = si.prim_index;
     if (a->per_face()) return components(*a, tri) * scale_;
     // The hit's barycentric coordinates, recovered from its position on the (world-space) triangle.
-    const uint32_t *idx = &si.shape->indices[3 * tri];
-    const Vec3 &p0 = si.shape->positions[idx[0]];
-    const Vec3 e1 = si.shape->positions[idx[1]] - p0, e2 = si.shape->positions[idx[2]] - p0, d = si.p - p0;
+    const uint32_t *idx = &mesh->indices[3 * tri];
+    const Vec3 &p0 = mesh->positions[idx[0]];
+    const Vec3 e1 = mesh->positions[idx[1]] - p0, e2 = mesh->positions[idx[2]] - p0, d = si.p - p0;
     const float d11 = dot(e1, e1), d12 = dot(e1, e2), d22 = dot(e2, e2), d1 = dot(d, e1), d2 = dot(d, e2);
     const float det = d11 * d22 - d12 * d12;
     if (!(det > 0)) return components(*a, idx[0]) * scale_;

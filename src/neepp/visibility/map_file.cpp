@@ -6,7 +6,6 @@
 #include "neepp/io/atomic_file.h"
 #include "neepp/io/binary_io.h"
 #include "neepp/scene/scene.h"
-#include "neepp/scene/sdf_grid.h"
 
 namespace neepp {
 
@@ -18,31 +17,17 @@ constexpr uint32_t kVersion = 1;
 }  // namespace
 
 uint64_t scene_fingerprint(const Scene &scene) {
-    uint64_t h = fnv1a64("neepp-scene-v1", 14);
-    auto mix = [&](const void *d, size_t n) { h = fnv1a64(d, n, h); };
+    // What each shape's digest adds is mixed in as it comes.
+    struct Digest final : GeometryDigest {
+        uint64_t h = fnv1a64("neepp-scene-v2", 14);
+        void add(const void *data, size_t bytes) override { h = fnv1a64(data, bytes, h); }
+        using GeometryDigest::add;
+    } digest;
     uint64_t shapes = scene.shapes().size(), lights = scene.lights().size();
-    mix(&shapes, sizeof shapes);
-    for (const auto &s : scene.shapes()) {
-        int kind = int(s->kind);
-        mix(&kind, sizeof kind);
-        uint64_t np = s->positions.size(), ni = s->indices.size();
-        mix(&np, sizeof np);
-        mix(&ni, sizeof ni);
-        if (np) mix(s->positions.data(), np * sizeof(Vec3));
-        if (ni) mix(s->indices.data(), ni * sizeof(uint32_t));
-        mix(&s->center, sizeof(Vec3));
-        mix(&s->radius, sizeof(float));
-        if (s->sdf_grid) {
-            const uint32_t dims[3] = {s->sdf_grid->size(0), s->sdf_grid->size(1), s->sdf_grid->size(2)};
-            mix(dims, sizeof dims);
-            mix(s->sdf_grid->values().data(), s->sdf_grid->values().size() * sizeof(float));
-            mix(&s->sdf_to_world.matrix, sizeof(Matrix4));
-        }
-        if (!s->curve_points.empty()) {  // only for curves: meshes and spheres keep their fingerprints
-            mix(s->curve_points.data(), s->curve_points.size() * sizeof(CurvePoint));
-            mix(s->curve_segments.data(), s->curve_segments.size() * sizeof(uint32_t));
-        }
-    }
+    digest.add(shapes);
+    for (const auto &s : scene.shapes()) s->digest(digest);
+    uint64_t &h = digest.h;
+    auto mix = [&](const void *d, size_t n) { h = fnv1a64(d, n, h); };
     mix(&lights, sizeof lights);
     for (const auto &l : scene.lights()) {
         uint8_t flags = uint8_t(l->is_infinite()) | uint8_t(l->is_delta() << 1);

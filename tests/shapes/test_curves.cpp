@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include "neepp/shapes/curve_shape.h"
 #include "neepp/materials/bumpmap.h"
 #include "neepp/materials/diffuse.h"
 #include "neepp/scene/scene.h"
@@ -17,11 +18,10 @@ namespace {
 // One curve shape; its BSDF, a flat bump map, reads tangents, so hits get dp/du, dp/dv and the frame along them.
 std::unique_ptr<Scene> curve_scene(CurveBasis basis, std::vector<CurvePoint> points, std::vector<uint32_t> segments) {
     auto scene = std::make_unique<Scene>();
-    auto s = std::make_unique<Shape>();
-    s->kind = Shape::Kind::Curve;
-    s->curve_basis = basis;
-    s->curve_points = std::move(points);
-    s->curve_segments = std::move(segments);
+    auto s = std::make_unique<CurveShape>();
+    s->basis = basis;
+    s->points = std::move(points);
+    s->segments = std::move(segments);
     s->bsdf = std::make_shared<BumpMapBSDF>(constant_texture(0.f), 1.f,
                                             std::make_shared<DiffuseBSDF>(constant_texture(Color(0.5f))));
     scene->add_shape(std::move(s));

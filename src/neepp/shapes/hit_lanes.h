@@ -1,7 +1,7 @@
 // Triangle hits filled eight at a time, in lanes (hit_lanes.cpp), for the path tracer's fast form: as
-// Shape::fill_interaction and then wi = to_local(-d) would fill them, one per lane, in SoA.
+// TriangleMesh::fill_interaction and then wi = to_local(-d) would fill them, one per lane, in SoA.
 #pragma once
-#include "neepp/scene/shape.h"
+#include "neepp/shapes/triangle_mesh.h"
 
 namespace neepp {
 
@@ -13,8 +13,8 @@ struct HitLanes {
     // The shape's options, as masks the kernel applies: -0 flips the normals (+0 not); all bits set where
     // the mesh has vertex normals to interpolate (and face_normals is off) / texture coordinates.
     alignas(32) float flip[kLanes], vertex_normals[kLanes], has_uv[kLanes];
-    const float *tri[kLanes];  // the triangle's record (Shape::HitTriangle)
-    const Shape *shape[kLanes];
+    const float *tri[kLanes];  // the triangle's record (TriangleMesh::HitTriangle)
+    const TriangleMesh *shape[kLanes];
     uint32_t prim[kLanes];
     SurfaceInteraction *out[kLanes];
     int n = 0;  // lanes in use
@@ -27,7 +27,7 @@ struct HitLanes {
 void fill_lanes(HitLanes &h);
 
 // Queues a hit on triangle prim of shape (shape.fills_in_lanes() must hold); the eighth fills all of them.
-inline void add_lane(HitLanes &h, const Shape &shape, uint32_t prim, float b1, float b2, float t, const Vec3 &d,
+inline void add_lane(HitLanes &h, const TriangleMesh &shape, uint32_t prim, float b1, float b2, float t, const Vec3 &d,
                      SurfaceInteraction &out) {
     const int i = h.n++;
     h.tri[i] = reinterpret_cast<const float *>(&shape.hit_triangles_[prim]);

@@ -3,6 +3,8 @@
 // way it is orthonormal around the same interpolated normal, so isotropic BSDFs give the same values.
 #include <gtest/gtest.h>
 
+#include "neepp/shapes/triangle_mesh.h"
+#include "neepp/shapes/sphere.h"
 #include "neepp/materials/diffuse.h"
 #include "neepp/materials/roughconductor.h"
 #include "neepp/materials/bumpmap.h"
@@ -10,15 +12,14 @@
 #include "neepp/materials/null.h"
 #include "neepp/materials/twosided.h"
 #include "neepp/sampling/rng.h"
-#include "neepp/scene/shape.h"
 
 using namespace neepp;
 
 namespace {
 
 // One bent quad with vertex normals and texture coordinates whose u axis is not along an edge.
-Shape make_quad(BSDFPtr bsdf) {
-    Shape s;
+TriangleMesh make_quad(BSDFPtr bsdf) {
+    TriangleMesh s;
     s.positions = {{0, 0, 0}, {2, 0, 0.3f}, {2, 1.5f, 0.8f}, {0, 1, 0}};
     s.normals = {normalize(Vec3(0.1f, 0, 1)), normalize(Vec3(-0.2f, 0.1f, 1)), normalize(Vec3(0, -0.3f, 1)),
                  Vec3(0, 0, 1)};
@@ -74,8 +75,8 @@ TEST(ShadingFrame, ABsdfThatDoesNotSayGetsTangents) {
 
 TEST(ShadingFrame, SameNormalAndUvWithOrWithoutTangents) {
     auto diffuse = std::make_shared<DiffuseBSDF>(constant_texture(Color(0.5f)));
-    const Shape plain = make_quad(diffuse);
-    const Shape bumped = make_quad(std::make_shared<BumpMapBSDF>(constant_texture(0.f), 1.f, diffuse));
+    const TriangleMesh plain = make_quad(diffuse);
+    const TriangleMesh bumped = make_quad(std::make_shared<BumpMapBSDF>(constant_texture(0.f), 1.f, diffuse));
     ASSERT_FALSE(plain.tangents);
     ASSERT_TRUE(bumped.tangents);
     PCG32 rng(11, 3);
@@ -107,8 +108,7 @@ namespace {
 // A sphere's frame follows dp/du (the azimuth direction) where its BSDF reads tangents, as Mitsuba's does.
 TEST(ShadingFrame, SphereFrameFollowsDpDuWhenTangentsAreRead) {
     TexturePtr a = constant_texture(0.2f), b = constant_texture(0.05f);
-    Shape s;
-    s.kind = Shape::Kind::Sphere;
+    Sphere s;
     s.center = Vec3(0.5f, -0.2f, 1.f);
     s.radius = 2.f;
     s.bsdf = std::make_shared<RoughConductorBSDF>(MicrofacetType::GGX, a, b, constant_texture(Color(0.2f)),
@@ -132,25 +132,24 @@ TEST(ShadingFrame, SphereFrameFollowsDpDuWhenTangentsAreRead) {
 // A turned sphere's uv and dp/du follow its own axes: at the world point along its local direction
 // (sin θ cos φ, sin θ sin φ, cos θ), uv is (φ / 2π, θ / π) whatever the turn, as in Mitsuba.
 TEST(ShadingFrame, TurnedSphereUvFollowsItsAxes) {
-    Shape s;
-    s.kind = Shape::Kind::Sphere;
+    Sphere s;
     s.center = Vec3(1.f, 2.f, 3.f);
     s.radius = 0.5f;
     // Local x, y, z along world y, z, x: a proper rotation.
-    s.sphere_axes[0] = Vec3(0, 1, 0), s.sphere_axes[1] = Vec3(0, 0, 1), s.sphere_axes[2] = Vec3(1, 0, 0);
+    s.axes[0] = Vec3(0, 1, 0), s.axes[1] = Vec3(0, 0, 1), s.axes[2] = Vec3(1, 0, 0);
     s.bsdf = std::make_shared<RoughConductorBSDF>(MicrofacetType::GGX, constant_texture(0.2f), constant_texture(0.2f),
                                                   constant_texture(Color(0.2f)), constant_texture(Color(3.f)));
     s.finalize();
     for (const auto &[theta, phi] : std::vector<std::pair<float, float>>{{0.7f, 0.3f}, {2.1f, 4.0f}, {1.2f, 5.9f}}) {
         const Vec3 local(std::sin(theta) * std::cos(phi), std::sin(theta) * std::sin(phi), std::cos(theta));
-        const Vec3 dir = s.sphere_axes[0] * local.x + s.sphere_axes[1] * local.y + s.sphere_axes[2] * local.z;
+        const Vec3 dir = s.axes[0] * local.x + s.axes[1] * local.y + s.axes[2] * local.z;
         const Ray ray{s.center + dir * 3.f, -dir, 0.f, kInfinity};
         SurfaceInteraction si;
         s.fill_interaction(0, 0.f, 0.f, ray, 2.5f, si);
         EXPECT_NEAR(si.uv.x, phi / (2 * kPi), 1e-5f);
         EXPECT_NEAR(si.uv.y, theta / kPi, 1e-5f);
         const Vec3 dpdu_local(-local.y, local.x, 0.f);
-        const Vec3 dpdu = (s.sphere_axes[0] * dpdu_local.x + s.sphere_axes[1] * dpdu_local.y) * (2 * kPi * s.radius);
+        const Vec3 dpdu = (s.axes[0] * dpdu_local.x + s.axes[1] * dpdu_local.y) * (2 * kPi * s.radius);
         EXPECT_LT(norm(si.dpdu - dpdu), 1e-4f);
         EXPECT_NEAR(norm(si.sh_frame.s - normalize(dpdu)), 0.f, 1e-4f);
     }

@@ -11,7 +11,7 @@ translates only: Mitsuba bounds a directly transformed grid's voxels by their tr
 a rotation breaks (it warns to use an instance instead).
 
 Run with the Python that has the mitsuba package (scripts/test.sh installs it in .venv):
-    .venv/bin/python tests/scene/generate_sdf_grid_reference.py > tests/scene/sdf_grid_reference.inc
+    .venv/bin/python tests/shapes/generate_sdf_grid_reference.py > tests/shapes/sdf_grid_reference.inc
 """
 import numpy as np
 import mitsuba as mi
@@ -64,7 +64,7 @@ def vec(v) -> str:
 def main():
     values = grid_values()
     print("// Reference values generated with Mitsuba %s (pip package, scalar_rgb variant) by" % mi.__version__)
-    print("// tests/scene/generate_sdf_grid_reference.py.")
+    print("// tests/shapes/generate_sdf_grid_reference.py.")
     print(f"constexpr uint32_t kReferenceGridSize[3] = {{{SIZE[0]}, {SIZE[1]}, {SIZE[2]}}};")
     print(f"const Vec3 kReferenceScale{vec(SCALE)}, kReferenceTranslate{vec(TRANSLATE)};")
     print("// x fastest, then y, then z.")

@@ -11,7 +11,7 @@
 #include "neepp/math/warp.h"
 #include "neepp/sampling/rng.h"
 #include "neepp/scene/scene.h"
-#include "neepp/scene/sdf_grid.h"
+#include "neepp/shapes/sdf_grid_shape.h"
 
 using namespace neepp;
 
@@ -32,10 +32,9 @@ std::shared_ptr<const SdfGrid> sphere_grid(int n, SdfGrid::Normals normals = Sdf
 
 std::unique_ptr<Scene> sdf_scene(std::shared_ptr<const SdfGrid> grid, const Transform &to_world) {
     auto scene = std::make_unique<Scene>();
-    auto s = std::make_unique<Shape>();
-    s->kind = Shape::Kind::SdfGrid;
-    s->sdf_grid = std::move(grid);
-    s->sdf_to_world = to_world;
+    auto s = std::make_unique<SdfGridShape>();
+    s->grid = std::move(grid);
+    s->to_world = to_world;
     scene->add_shape(std::move(s));
     scene->build();
     return scene;
@@ -74,7 +73,7 @@ TEST(SdfGrid, HitsTheSphereItHoldsAtItsDistanceWithItsNormal) {
     const Sphere sphere;
     for (SdfGrid::Normals normals : {SdfGrid::Normals::Smooth, SdfGrid::Normals::Analytic}) {
         auto scene = sdf_scene(sphere_grid(41, normals), kToWorld);
-        const Shape &shape = *scene->shapes()[0];
+        const auto &shape = dynamic_cast<const SdfGridShape &>(*scene->shapes()[0]);
         PCG32 rng;
         rng.seed(1, 2);
         for (int i = 0; i < 500; ++i) {
@@ -93,8 +92,8 @@ TEST(SdfGrid, HitsTheSphereItHoldsAtItsDistanceWithItsNormal) {
             EXPECT_NEAR(norm(si.n), 1.f, 1e-5f);
             EXPECT_NEAR(norm(si.sh_frame.n), 1.f, 1e-5f);
             // The voxel's box, which Embree culls by, holds the hit.
-            const BBox &box = shape.sdf_grid->surface_bounds(hit.prim);
-            EXPECT_TRUE(box.contains(shape.sdf_to_object().point(si.p))) << i;
+            const BBox &box = shape.grid->surface_bounds(hit.prim);
+            EXPECT_TRUE(box.contains(shape.to_object().point(si.p))) << i;
             EXPECT_TRUE(scene->occluded(ray));
         }
     }

@@ -9,15 +9,14 @@
 
 #include "neepp/materials/diffuse.h"
 #include "neepp/sampling/rng.h"
-#include "neepp/scene/hit_lanes.h"
-#include "neepp/scene/shape.h"
+#include "neepp/shapes/hit_lanes.h"
 
 using namespace neepp;
 
 namespace {
 
-std::unique_ptr<Shape> make_mesh(bool normals, bool uvs, bool flip, bool face_normals, bool cancelling_normal) {
-    auto s = std::make_unique<Shape>();
+std::unique_ptr<TriangleMesh> make_mesh(bool normals, bool uvs, bool flip, bool face_normals, bool cancelling_normal) {
+    auto s = std::make_unique<TriangleMesh>();
     s->positions = {{0, 0, 0}, {2, 0, 0.3f}, {2, 1.5f, 0.8f}, {0, 1, 0}};
     if (normals) {
         s->normals = {normalize(Vec3(0.1f, 0, 1)), normalize(Vec3(-0.2f, 0.1f, 1)), normalize(Vec3(0, -0.3f, 1)),
@@ -41,7 +40,7 @@ void expect_near(const Vec3 &a, const Vec3 &b, const char *what) {
 }
 
 struct Hit {
-    const Shape *shape;
+    const TriangleMesh *shape;
     uint32_t prim;
     float b1, b2, t;
     Vec3 d;
@@ -67,7 +66,7 @@ void expect_same_record(const SurfaceInteraction &wide, const Hit &h) {
 }
 
 TEST(FillLanes, SameRecordsAsOneAtATime) {
-    std::vector<std::unique_ptr<Shape>> shapes;
+    std::vector<std::unique_ptr<TriangleMesh>> shapes;
     for (int bits = 0; bits < 32; ++bits)
         shapes.push_back(make_mesh(bits & 1, bits & 2, bits & 4, bits & 8, bits & 16));
     for (const auto &s : shapes) ASSERT_TRUE(s->fills_in_lanes());

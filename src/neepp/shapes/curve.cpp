@@ -1,4 +1,4 @@
-#include "neepp/scene/curve.h"
+#include "neepp/shapes/curve.h"
 
 #include <cmath>
 #include "neepp/math/frame.h"

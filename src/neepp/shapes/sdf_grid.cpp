@@ -1,4 +1,4 @@
-#include "neepp/scene/sdf_grid.h"
+#include "neepp/shapes/sdf_grid.h"
 
 #include <array>
 #include <cmath>

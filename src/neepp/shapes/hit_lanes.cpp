@@ -7,7 +7,7 @@
 // three rows of 8 floats, and so are the first 24 floats of a hit record.
 #include <cstddef>
 
-#include "neepp/scene/hit_lanes.h"
+#include "neepp/shapes/hit_lanes.h"
 
 #include "neepp/math/lanes.h"
 #include "neepp/math/transpose.h"

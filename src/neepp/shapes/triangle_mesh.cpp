@@ -1,31 +1,19 @@
-#include "neepp/scene/shape.h"
+#include "neepp/shapes/triangle_mesh.h"
 
 #include <algorithm>
 #include <bit>
 #include <cmath>
+#include <stdexcept>
 
 #include "neepp/math/warp.h"
-#include "neepp/scene/sdf_grid.h"
 
 namespace neepp {
 
-void Shape::finalize() {
-    tangents = !bsdf || bsdf->needs_tangents();
-    bsdf_flags = bsdf ? bsdf->flags() : 0;
+void TriangleMesh::precompute() {
     const float all_bits = std::bit_cast<float>(~0u);
     lane_flip_ = flip_normals ? -0.f : 0.f;
     lane_vertex_normals_ = (face_normals || normals.empty()) ? 0.f : all_bits;
     lane_has_uv_ = uvs.empty() ? 0.f : all_bits;
-    if (kind == Kind::Sphere) {
-        area_ = 4.f * kPi * radius * radius;
-        return;
-    }
-    if (kind == Kind::SdfGrid) {
-        area_ = 0;  // as Mitsuba's: nothing samples a point on it
-        sdf_to_object_ = sdf_to_world.inverse();
-        return;
-    }
-    if (kind == Kind::Curve) return;  // no area: curves cannot emit
     std::vector<float> areas(triangle_count());
     double total = 0;
     for (size_t i = 0; i < areas.size(); ++i) {
@@ -51,14 +39,14 @@ void Shape::finalize() {
         for (size_t i = 0; i < triangle_count(); ++i) sampling_triangles_.push_back(sampling_triangle(i));
 }
 
-Shape::SamplingTriangle Shape::sampling_triangle(size_t tri) const {
+TriangleMesh::SamplingTriangle TriangleMesh::sampling_triangle(size_t tri) const {
     if (tri < sampling_triangles_.size()) return sampling_triangles_[tri];
     const Vec3 &p0 = positions[indices[3 * tri]], &p1 = positions[indices[3 * tri + 1]], &p2 = positions[indices[3 * tri + 2]];
     const Vec3 n = normalize(cross(p1 - p0, p2 - p0));
     return {p0, p1 - p0, p2 - p0, flip_normals ? -n : n};
 }
 
-std::optional<Shape::Parallelogram> Shape::find_parallelogram() const {
+std::optional<TriangleMesh::Parallelogram> TriangleMesh::find_parallelogram() const {
     if (triangle_count() != 2) return std::nullopt;
     // The diagonal is the edge the triangles share; the other vertex of each is a corner beside it.
     const uint32_t *t0 = &indices[0], *t1 = &indices[3];
@@ -96,34 +84,74 @@ std::optional<Shape::Parallelogram> Shape::find_parallelogram() const {
     return q;
 }
 
-BBox Shape::bounds() const {
+BBox TriangleMesh::bounds() const {
     BBox b;
-    if (kind == Kind::Sphere) {
-        b.expand(center - Vec3(radius));
-        b.expand(center + Vec3(radius));
-    } else if (kind == Kind::SdfGrid) {
-        for (int k = 0; k < 8; ++k) b.expand(sdf_to_world.point(Vec3(float(k & 1), float(k >> 1 & 1), float(k >> 2 & 1))));
-    } else if (kind == Kind::Curve) {
-        // A segment's every point is a convex combination of its control points, each moved by its own radius.
-        for (const CurvePoint &cp : curve_points) {
-            b.expand(cp.p - Vec3(cp.radius));
-            b.expand(cp.p + Vec3(cp.radius));
-        }
-    } else {
-        for (const Vec3 &p : positions) b.expand(p);
-    }
+    for (const Vec3 &p : positions) b.expand(p);
     return b;
 }
 
-PositionSample Shape::sample_position(Vec2 u, bool with_uv) const {
+RTCGeometry TriangleMesh::embree_geometry(RTCDevice device) const {
+    if (indices.empty()) return nullptr;  // nothing to intersect; the shape keeps its index all the same
+    RTCGeometry geom = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_TRIANGLE);
+    float *v = (float *)rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3,
+                                                3 * sizeof(float), positions.size());
+    for (size_t k = 0; k < positions.size(); ++k) {
+        v[3 * k] = positions[k].x; v[3 * k + 1] = positions[k].y; v[3 * k + 2] = positions[k].z;
+    }
+    uint32_t *idx = (uint32_t *)rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
+                                                        3 * sizeof(uint32_t), triangle_count());
+    std::copy(indices.begin(), indices.end(), idx);
+    return geom;
+}
+
+void TriangleMesh::transform(const Transform &to_world) {
+    for (Vec3 &p : positions) {
+        p = to_world.point(p);
+        if (!is_finite(p)) throw std::runtime_error("the transformed mesh has non-finite vertices");
+    }
+    for (Vec3 &n : normals) {
+        n = to_world.normal(n);
+        const float len = norm(n);
+        if (len > 0) n = n / len;
+    }
+}
+
+DirectionCone TriangleMesh::normal_bounds() const {
+    DirectionCone cone;
+    bool first = true;
+    auto add = [&](const DirectionCone &c) {
+        cone = first ? c : cone_union(cone, c);
+        first = false;
+    };
+    if (!face_normals)
+        for (const Vec3 &vn : normals) {
+            const float len = norm(vn);
+            if (len > 0) add(DirectionCone{(flip_normals ? -vn : vn) / len, 1.f});
+            if (cone.is_entire_sphere()) return cone;
+        }
+    for (size_t t = 0; t < triangle_count(); ++t) {
+        const Vec3 &p0 = positions[indices[3 * t]], &p1 = positions[indices[3 * t + 1]], &p2 = positions[indices[3 * t + 2]];
+        Vec3 c = cross(p1 - p0, p2 - p0);
+        float len = norm(c);
+        if (!(len > 0)) continue;  // degenerate: zero area, never sampled
+        add(DirectionCone{(flip_normals ? -c : c) / len, 1.f});
+        if (cone.is_entire_sphere()) break;
+    }
+    return cone;
+}
+
+void TriangleMesh::digest(GeometryDigest &d) const {
+    d.add("mesh", 4);
+    const uint64_t np = positions.size(), ni = indices.size();
+    d.add(np);
+    d.add(ni);
+    if (np) d.add(positions.data(), np * sizeof(Vec3));
+    if (ni) d.add(indices.data(), ni * sizeof(uint32_t));
+}
+
+PositionSample TriangleMesh::sample_position(Vec2 u, bool with_uv) const {
     PositionSample ps;
     ps.pdf = pdf_position();
-    if (kind == Kind::Sphere) {
-        Vec3 d = square_to_uniform_sphere(u);
-        ps.p = center + d * radius;
-        ps.n = ps.ns = flip_normals ? -d : d;
-        return ps;
-    }
     if (parallelogram_ && (!with_uv || parallelogram_->uv_affine)) {
         const Parallelogram &q = *parallelogram_;
         ps.p = q.p0 + q.e1 * u.x + q.e2 * u.y;
@@ -150,25 +178,10 @@ PositionSample Shape::sample_position(Vec2 u, bool with_uv) const {
     return ps;
 }
 
-namespace {
-
-// The shading frame around n with s along dp/du made perpendicular to n (Gram-Schmidt), as Mitsuba aligns
-// it, so anisotropic and bump-mapped materials have a consistent tangent; around n alone where dp/du has
-// no part across n.
-[[gnu::always_inline]] inline Frame frame_along(const Vec3 &n, const Vec3 &dpdu) {
-    Vec3 s = dpdu - n * dot(n, dpdu);
-    const float s2 = squared_norm(s);
-    if (!(s2 > 1e-20f && std::isfinite(s2))) return Frame(n);
-    s = s / std::sqrt(s2);
-    return Frame(s, cross(n, s), n);
-}
-
-}  // namespace
-
 // Always inlined into fill_interaction (both of its paths; GCC otherwise keeps it out of line, and the
 // call is costly on a path this hot). Inlined, its arithmetic may fuse differently with the caller's
 // (FMA), which moves a few paths onto other random decisions: the same image statistically, not to the bit.
-[[gnu::always_inline]] inline Vec3 Shape::shading_normal(const HitTriangle &tri, float b0, float b1, float b2, const Vec3 &ng) const {
+[[gnu::always_inline]] inline Vec3 TriangleMesh::shading_normal(const HitTriangle &tri, float b0, float b1, float b2, const Vec3 &ng) const {
     if (face_normals || normals.empty()) return ng;
     Vec3 ns = tri.n[0] * b0 + tri.n[1] * b1 + tri.n[2] * b2;
     float len2 = squared_norm(ns);
@@ -177,50 +190,11 @@ namespace {
     return flip_normals ? -ns : ns;
 }
 
-void Shape::fill_interaction(uint32_t prim, float b1, float b2, const Ray &ray, float t,
-                             SurfaceInteraction &si) const {
+void TriangleMesh::fill_interaction(uint32_t prim, float b1, float b2, const Ray &, float t,
+                                    SurfaceInteraction &si) const {
     si.t = t;
     si.shape = this;
     si.prim_index = prim;
-    if (kind == Kind::Sphere) {
-        si.p = ray.at(t);
-        const Vec3 d = normalize(si.p - center);
-        si.p = center + d * radius;  // re-project for precision
-        si.n = flip_normals ? -d : d;
-        // Mitsuba's sphere uv: (phi / 2pi, theta / pi) in the sphere's frame.
-        const Vec3 local(dot(d, sphere_axes[0]), dot(d, sphere_axes[1]), dot(d, sphere_axes[2]));
-        float phi = std::atan2(local.y, local.x);
-        if (phi < 0) phi += 2.f * kPi;
-        si.uv = Vec2(phi * kInv2Pi, std::acos(std::clamp(local.z, -1.f, 1.f)) * kInvPi);
-        si.dpdu = (sphere_axes[1] * local.x - sphere_axes[0] * local.y) * (2.f * kPi * radius);
-        si.dpdv = cross(si.n, si.dpdu);
-        // Aligned with dp/du where the BSDF reads tangents, as Mitsuba; at the poles dp/du vanishes.
-        const float du2 = squared_norm(si.dpdu);
-        if (tangents && du2 > 0.f) {
-            const Vec3 s = si.dpdu / std::sqrt(du2);
-            si.sh_frame = Frame(s, cross(si.n, s), si.n);
-        } else {
-            si.sh_frame = Frame(si.n);
-        }
-        return;
-    }
-    if (kind == Kind::SdfGrid) return fill_sdf_interaction(ray, t, si);
-    if (kind == Kind::Curve) {
-        si.p = ray.at(t);
-        const CurveHit h = curve_hit(curve_basis, &curve_points[curve_segments[prim]], prim,
-                                     uint32_t(curve_segments.size()), b1, si.p);
-        si.n = h.n;
-        si.uv = h.uv;
-        // Mitsuba's curves shade with the geometric normal, the frame's s around the tube.
-        if (tangents) {
-            si.dpdu = h.dpdu, si.dpdv = h.dpdv;
-            si.sh_frame = frame_along(h.n, h.dpdu);
-        } else {
-            si.dpdu = si.dpdv = Vec3(0.f);
-            si.sh_frame = Frame(h.n);
-        }
-        return;
-    }
     const HitTriangle &tri = hit_triangles_[prim];
     const Vec3 &p0 = tri.p[0], &p1 = tri.p[1], &p2 = tri.p[2];
     float b0 = 1.f - b1 - b2;
@@ -255,23 +229,6 @@ void Shape::fill_interaction(uint32_t prim, float b1, float b2, const Ray &ray, 
     }
 
     si.sh_frame = frame_along(shading_normal(tri, b0, b1, b2, ng), si.dpdu);
-}
-
-// As Mitsuba's sdfgrid: the point on the ray; the geometric normal the gradient of the hit voxel's
-// interpolant, the shading normal by the grid's `normals` option, both moved by to_world as normals are.
-void Shape::fill_sdf_interaction(const Ray &ray, float t, SurfaceInteraction &si) const {
-    si.p = ray.at(t);
-    const Vec3 local = sdf_to_object_.point(si.p);
-    // A gradient of zero (a flat spot of a degenerate grid) has no direction: the side the ray came from.
-    auto world_normal = [&](const Vec3 &n, const Vec3 &fallback) {
-        const Vec3 w = sdf_to_world.normal(n);
-        const float len = norm(w);
-        return len > 0 && std::isfinite(len) ? w / len : fallback;
-    };
-    si.n = world_normal(sdf_grid->gradient(local), -normalize(ray.d));
-    si.sh_frame = Frame(world_normal(sdf_grid->shading_normal(local), si.n));
-    si.uv = Vec2(0.f, 0.f);
-    si.dpdu = si.dpdv = Vec3(0.f);
 }
 
 }  // namespace neepp
