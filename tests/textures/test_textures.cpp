@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <filesystem>
+#include <memory>
 #include <stdexcept>
 
 #include "neepp/textures/bitmap_texture.h"
@@ -89,7 +90,7 @@ TEST(BitmapTexture, WrapModesAtTheBorder) {
 }
 
 TEST(BitmapTexture, RepeatedLookupsAtOnePointAgreeWithFreshOnes) {
-    // eval keeps its last lookup in the SurfaceInteraction: a second lookup at the same point must give
+    // eval keeps its last lookup at each shading point: a second lookup at the same point must give
     // the same value, one at another uv (same object, moved) or of another texture must not get it.
     BitmapTexture a(coords_image(W, H)), b(coords_image(2 * W, 2 * H));
     SurfaceInteraction si = at_uv(0.3f, 0.6f);
@@ -122,6 +123,25 @@ TEST(BitmapTexture, RepeatedLookupsAtOnePointAgreeWithFreshOnes) {
             b.prefetch(r);
             expect_color(t->eval(r), t->eval(at_uv(u, 0.7f)), 0.f);
         }
+    }
+}
+
+// The memos outlive the textures: one made later, where an earlier one was, reads its own texels at a point
+// the earlier one was read at (and a copy, which has the same texels, may share the earlier's lookups).
+TEST(BitmapTexture, ALaterTextureAtTheSameAddressFindsNoneOfTheEarliersLookups) {
+    const SurfaceInteraction si = at_uv(0.3f, 0.6f);
+    Image dark = coords_image(W, H), bright = coords_image(W, H);
+    for (float &v : bright.data) v += 100.f;
+    for (int round = 0; round < 8; ++round) {
+        auto first = std::make_unique<BitmapTexture>(round % 2 ? bright : dark);
+        first->prefetch(si);
+        const Color before = first->eval(si);
+        first.reset();
+        auto second = std::make_unique<BitmapTexture>(round % 2 ? dark : bright);
+        const Color after = second->eval(si);
+        EXPECT_NEAR(std::abs(after.x - before.x), 100.f, 1e-3f) << round;
+        const BitmapTexture copy = *second;
+        expect_color(copy.eval(si), after, 0.f);
     }
 }
 

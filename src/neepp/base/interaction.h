@@ -56,20 +56,6 @@ struct SurfaceInteraction {
     Vec3 wi;            // direction toward the previous vertex, in the shading frame (Mitsuba's si.wi)
     const Shape *shape = nullptr;
     uint32_t prim_index = 0;
-    // The last bitmap-texture lookup made at this point: a BSDF reads its textures when next event
-    // estimation evaluates it and again when it is sampled, and the second read is then a copy; the
-    // prefetch before both leaves the texel footprint it located, so the first read does not locate it
-    // again. Keyed by the texture and the uv (a bitmap's value depends on nothing else), so it never needs
-    // resetting and a SurfaceInteraction moved to another uv cannot return a stale value.
-    struct TextureMemo {
-        const void *texture = nullptr;
-        Vec2 uv;
-        bool has_value = false;  // else only located (by a prefetch): footprint and weights below
-        Color value;
-        int texel[4];            // bilinear footprint: x0, x1, y0, y1
-        float weight[4];         // wx0, wx1, wy0, wy1
-    };
-    mutable TextureMemo texture_memo;
 
     bool is_valid() const { return shape != nullptr; }
     Vec3 to_local(const Vec3 &v) const { return sh_frame.to_local(v); }

@@ -1,5 +1,6 @@
 #include "neepp/textures/bitmap_texture.h"
 
+#include <atomic>
 #include <array>
 #include <cmath>
 #include <stdexcept>
@@ -199,38 +200,59 @@ Color BitmapTexture::blend(const Lookup &l) const {
     return out;
 }
 
-namespace {
-bool memo_of(const SurfaceInteraction::TextureMemo &memo, const void *texture, Vec2 uv) {
-    return memo.texture == texture && memo.uv.x == uv.x && memo.uv.y == uv.y;
+// The last lookup made at a shading point: a BSDF reads its textures when next event estimation
+// evaluates it and again when it is sampled, and the second read is then a copy; the prefetch before both
+// (the fast form's) leaves the texel footprint it located, so the first read does not locate it again.
+// Keyed by the texture and the uv, on which alone a bitmap's value depends: a memo found is what a new
+// lookup would give, to the bit, so it never needs resetting and cannot return a stale value.
+struct BitmapTexture::Memo {
+    uint64_t texture;  // the texture's memo key; 0: empty
+    Vec2 uv;
+    bool has_value;  // else only located (by a prefetch): the footprint below
+    Color value;
+    Lookup footprint;
+    bool holds(uint64_t key, Vec2 at) const { return texture == key && uv.x == at.x && uv.y == at.y; }
+};
+
+uint64_t BitmapTexture::next_memo_key() {
+    static std::atomic<uint64_t> next{1};
+    return next.fetch_add(1, std::memory_order_relaxed);
 }
-}  // namespace
+
+// Each thread's memos, one slot per shading point in flight (chosen by the SurfaceInteraction's address):
+// the fast form prefetches a batch of paths' textures before it reads any, so one memo would hold only
+// the last path's. Two points that share a slot cost a lookup, never a wrong value.
+BitmapTexture::Memo &BitmapTexture::memo_at(const SurfaceInteraction &si) {
+    constexpr int kSlotBits = 6;
+    thread_local Memo memos[1 << kSlotBits];  // zero-initialized: empty
+    const uint64_t key = reinterpret_cast<uintptr_t>(&si) * 0x9E3779B97F4A7C15ull;
+    return memos[key >> (64 - kSlotBits)];
+}
 
 void BitmapTexture::prefetch(const SurfaceInteraction &si) const {
-    SurfaceInteraction::TextureMemo &memo = si.texture_memo;
-    if (memo_of(memo, this, si.uv)) return;  // located or read already
+    Memo &memo = memo_at(si);
+    if (memo.holds(memo_key_, si.uv)) return;  // located or read already
     const Lookup l = locate(to_uv_.apply(si.uv));  // both rows of the bilinear footprint (nearest: a subset)
     for (int y : {l.y0, l.y1}) {
         const size_t i = (size_t(y) * width_ + l.x0) * channels_;
         if (!codes_.empty()) __builtin_prefetch(&codes_[i]);
         else __builtin_prefetch(&texels_[i]);
     }
-    memo = {this, si.uv, false, Color(0.f), {l.x0, l.x1, l.y0, l.y1}, {l.wx0, l.wx1, l.wy0, l.wy1}};
+    memo = {memo_key_, si.uv, false, Color(0.f), l};
 }
 
 Color BitmapTexture::eval(const SurfaceInteraction &si) const {
-    SurfaceInteraction::TextureMemo &memo = si.texture_memo;
-    if (memo_of(memo, this, si.uv)) {
+    Memo &memo = memo_at(si);
+    if (memo.holds(memo_key_, si.uv)) {
         if (memo.has_value) return memo.value;
         if (options_.filter == FilterType::Bilinear) {
-            const Lookup l{memo.texel[0], memo.texel[1], memo.texel[2], memo.texel[3],
-                           memo.weight[0], memo.weight[1], memo.weight[2], memo.weight[3]};
-            memo.value = blend(l);
+            memo.value = blend(memo.footprint);
             memo.has_value = true;
             return memo.value;
         }
     }
     const Color c = interpolate(to_uv_.apply(si.uv));
-    memo = {this, si.uv, true, c, {}, {}};
+    memo = {memo_key_, si.uv, true, c, {}};
     return c;
 }
 

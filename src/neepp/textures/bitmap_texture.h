@@ -75,6 +75,8 @@ public:
 
 private:
     struct Lookup;  // texel indices and bilinear weights of one query
+    struct Memo;    // a lookup kept for the next read at the same point (bitmap_texture.cpp)
+    static Memo &memo_at(const SurfaceInteraction &si);
     Lookup locate(Vec2 uv) const;
     Color texel(int x, int y) const;  // already wrapped coordinates
     Color interpolate(Vec2 uv) const;
@@ -93,6 +95,10 @@ private:
     UvTransform to_uv_;
     float mean_ = 0;
     Color mean_rgb_;
+    // Names this texture in the memos, which outlive it: a texture made later at the same address must not
+    // find this one's lookups.
+    uint64_t memo_key_ = next_memo_key();
+    static uint64_t next_memo_key();
 };
 
 }  // namespace neepp
