@@ -7,6 +7,7 @@
 #include <set>
 
 #include <fmt/core.h>
+#include "neepp/io/image.h"
 #include "neepp/loader/factories.h"
 #include "neepp/loader/problems.h"
 
@@ -39,7 +40,7 @@ namespace {
 
 void load_film(const XmlNode &film, Scene &scene) {
     if (film.type != "hdrfilm") throw film.error("unsupported film '" + film.type + "' (supported: " + supported_list("film") + ")");
-    constexpr int kMaxSide = 1 << 15;
+    constexpr int kMaxSide = kMaxImageSide;
     const NumberRange side = NumberRange::between(1, kMaxSide);
     scene.camera.width = film.get_int("width", 768, side);
     scene.camera.height = film.get_int("height", 576, side);
