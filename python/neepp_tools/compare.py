@@ -27,6 +27,11 @@ import json
 import sys
 from pathlib import Path
 
+if __name__ == "__main__":  # `neepp compare`: say what is missing before importing it
+    from .requirements import COMPARE_ANY_OF, COMPARE_REQUIRED, require
+
+    require("neepp compare", COMPARE_REQUIRED, COMPARE_ANY_OF)
+
 import numpy as np
 
 from . import credit, machine, metrics, runner

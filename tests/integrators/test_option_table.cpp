@@ -68,3 +68,21 @@ TEST(OptionTable, EveryOptionTheFactoryReadsIsListed) {
         for (const std::string &key : options.asked()) EXPECT_TRUE(known.count(key)) << name << " reads '" << key << "', not in its table";
     }
 }
+
+// A number option of nan or inf (from -I or a scene's integrator) is refused naming the option and the
+// value, as a misspelt number is: no option means anything by them.
+TEST(OptionTable, NonFiniteNumbersAreRefused) {
+    for (const char *value : {"nan", "inf", "-inf", "1e39"}) {
+        Options o;
+        o.set("shadow_rays", "neepp");
+        o.set("q_min", value);
+        try {
+            make_integrator("path", o);
+            ADD_FAILURE() << "q_min=" << value << " was accepted";
+        } catch (const std::invalid_argument &e) {
+            const std::string msg = e.what();
+            EXPECT_NE(msg.find("q_min"), std::string::npos) << msg;
+            EXPECT_NE(msg.find(std::string("'") + value + "'"), std::string::npos) << msg;
+        }
+    }
+}

@@ -4,6 +4,8 @@
 #include <fstream>
 #include <sstream>
 #include <stdexcept>
+#include <sys/wait.h>
+#include <unistd.h>
 
 #include "../common/temp_dir.h"
 #include "neepp/io/atomic_file.h"
@@ -75,4 +77,26 @@ TEST(AtomicFile, ImagesAreWrittenThroughIt) {
     EXPECT_EQ(read_image(exr).width, 4);
     EXPECT_EQ(read_image((tmp.dir / "a.png").string()).height, 3);
     EXPECT_EQ(files_in(tmp.dir), 2u);
+}
+
+// A render killed by SIGKILL leaves its hidden temporary: the next write of the same output removes it,
+// but never a temporary of a process still running (another render writing there), nor another output's.
+TEST(AtomicFile, StaleTemporariesOfDeadProcessesAreRemovedAtTheNextWrite) {
+    neepp::testing::TempDir tmp;
+    const std::string path = (tmp.dir / "image.exr").string();
+    // A process that has exited (and been waited for): its pid names no process now.
+    const pid_t child = fork();
+    ASSERT_GE(child, 0);
+    if (child == 0) _exit(0);
+    ASSERT_EQ(waitpid(child, nullptr, 0), child);
+    const std::string dead = tmp.write(".image.exr." + std::to_string(child) + ".tmp", "half-written");
+    const std::string live = tmp.write(".image.exr." + std::to_string(getppid()) + ".tmp", "being written");
+    const std::string other = tmp.write(".other.exr." + std::to_string(child) + ".tmp", "another output's");
+    const std::string not_ours = tmp.write(".image.exr.backup.tmp", "a user's");
+    write_file_atomically(path, std::string("new"));
+    EXPECT_EQ(read_all(path), "new");
+    EXPECT_FALSE(std::filesystem::exists(dead));
+    EXPECT_TRUE(std::filesystem::exists(live));
+    EXPECT_TRUE(std::filesystem::exists(other));
+    EXPECT_TRUE(std::filesystem::exists(not_ours));
 }

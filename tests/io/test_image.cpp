@@ -1,6 +1,9 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstring>
+#include <iterator>
+#include <sys/resource.h>
 #include <filesystem>
 #include <fstream>
 #include <stdexcept>
@@ -149,4 +152,59 @@ TEST(Image, SrgbTransferFunctionsArePiecewiseAndInverse) {
         float v = i / 255.f;
         EXPECT_NEAR(linear_to_srgb(srgb_to_linear(v)), v, 2e-6f);
     }
+}
+
+namespace {
+
+// The file's bytes with its dataWindow attribute (a box2i: xmin, ymin, xmax, ymax) set to the window given.
+std::string with_data_window(std::string bytes, int32_t xmin, int32_t ymin, int32_t xmax, int32_t ymax) {
+    const std::string attribute("dataWindow\0box2i\0", 17);
+    const size_t at = bytes.find(attribute);
+    if (at == std::string::npos) throw std::logic_error("no dataWindow in the EXR header");
+    const int32_t box[4] = {xmin, ymin, xmax, ymax};
+    std::memcpy(&bytes[at + attribute.size() + 4], box, sizeof box);  // after the attribute's size (16)
+    return bytes;
+}
+
+std::string read_bytes(const std::string &path) {
+    std::ifstream in(path, std::ios::binary);
+    return std::string(std::istreambuf_iterator<char>(in), {});
+}
+
+}  // namespace
+
+// A damaged header may ask for any data window: beyond the film's cap it is refused from the header, and a
+// window within it that the file's data does not cover is refused before its pixels are allocated (a
+// 30000² RGB window is 10 GB of floats; the fuzzer met such headers at every other input).
+TEST(Image, ExrDataWindowIsCappedBeforeThePixelsAreRead) {
+    const std::string path = temp_path("window.exr");
+    write_exr(path, ramp(4, 3, 3));
+    const std::string good = read_bytes(path);
+    EXPECT_EQ(read_image(path).width, 4);
+    auto message = [&](const std::string &bytes) {
+        std::ofstream(path, std::ios::binary | std::ios::trunc) << bytes;
+        try {
+            read_image(path);
+        } catch (const std::runtime_error &e) {
+            return std::string(e.what());
+        }
+        return std::string("(read)");
+    };
+    for (auto [w, h] : {std::pair{40000, 3}, std::pair{4, 40000}, std::pair{2000000000, 2000000000}}) {
+        const std::string msg = message(with_data_window(good, 0, 0, w - 1, h - 1));
+        EXPECT_NE(msg.find(path), std::string::npos) << msg;
+        EXPECT_NE(msg.find("data window"), std::string::npos) << w << "x" << h << ": " << msg;
+        if (w < 100000) EXPECT_NE(msg.find("32768"), std::string::npos) << w << "x" << h << ": " << msg;
+    }
+    // Within the cap, a window the file's data does not cover: refused before its 10 GB of pixels are
+    // allocated (the process would grow by them, or be killed).
+    rusage before{}, after{};
+    getrusage(RUSAGE_SELF, &before);
+    const std::string msg = message(with_data_window(good, 0, 0, 29999, 29999));
+    getrusage(RUSAGE_SELF, &after);
+    EXPECT_NE(msg.find(path), std::string::npos) << msg;
+    EXPECT_NE(msg.find("(read)"), 0u) << msg;
+    EXPECT_LT(after.ru_maxrss - before.ru_maxrss, 256 * 1024) << "kB grown: " << after.ru_maxrss - before.ru_maxrss;
+    EXPECT_EQ(message(good), "(read)");
+    std::filesystem::remove(path);
 }

@@ -124,3 +124,22 @@ def test_bad_input_is_a_clear_error(neepp_bin, tmp_path, args, expect):
     r = subprocess.run([str(neepp_bin), "compare", str(DEMO), "--time", "0.2", "-o", str(tmp_path / "o"), *SIZE, *args],
                        capture_output=True, text=True, timeout=120)
     assert r.returncode == 1 and expect in r.stderr, (r.returncode, r.stderr[-2000:])
+
+
+def test_without_its_python_modules_it_says_what_is_missing(neepp_bin, tmp_path):
+    """A checkout without .venv (a user who ran only the demo) runs compare with a bare python3: one message
+    naming what is missing and the command that installs it, not a traceback."""
+    import os
+    import sys
+
+    bare = tmp_path / "bare_python"
+    bare.write_text(f'#!/bin/sh\nexec "{sys.executable}" -S "$@"\n')  # -S: no site-packages, no numpy
+    bare.chmod(0o755)
+    env = dict(os.environ, NEEPP_PYTHON=str(bare))
+    r = subprocess.run([str(neepp_bin), "compare", str(DEMO), "--time", "0.2", "-o", str(tmp_path / "o"), *SIZE],
+                       capture_output=True, text=True, timeout=120, env=env)
+    assert r.returncode == 1, (r.returncode, r.stderr[-2000:])
+    assert "Traceback" not in r.stderr, r.stderr[-2000:]
+    assert "numpy" in r.stderr and "matplotlib" in r.stderr, r.stderr[-2000:]
+    assert "scripts/setup_python.sh" in r.stderr and "NEEPP_PYTHON" in r.stderr, r.stderr[-2000:]
+    assert not (tmp_path / "o").exists()

@@ -1,5 +1,6 @@
 #include "neepp/base/options.h"
 
+#include <cmath>
 #include <stdexcept>
 
 namespace neepp {
@@ -31,7 +32,8 @@ float Options::get_float(const std::string &key, float def) const {
     size_t pos = 0;
     float v = 0;
     try { v = std::stof(it->second, &pos); } catch (...) { bad_value(key, it->second, "number"); }
-    if (pos != it->second.size()) bad_value(key, it->second, "number");
+    // nan and inf parse, but no option means anything by them.
+    if (pos != it->second.size() || !std::isfinite(v)) bad_value(key, it->second, "finite number");
     return v;
 }
 

@@ -9,7 +9,8 @@ namespace neepp {
 // Calls write(temporary) to write the whole file to a temporary path in the target's folder (the same
 // file system, so the rename is atomic), flushes it to disk, then renames it over path. On any failure
 // the temporary file is removed and the target left as it was; write's exceptions propagate, and a
-// failed flush or rename throws std::runtime_error naming path.
+// failed flush or rename throws std::runtime_error naming path. The temporary is ".NAME.PID.tmp"; those of
+// NAME that processes no longer running left (a render killed by SIGKILL) are removed first.
 void write_file_atomically(const std::string &path, const std::function<void(const std::string &temporary)> &write);
 
 // The same for a file whose whole content is in memory (statistics JSON, visibility maps).

@@ -128,10 +128,21 @@ Image read_exr(const std::string &path) {
         // until given threads (on one thread, a large environment map is a good part of a scene's load).
         [[maybe_unused]] static const bool pool = [] {
             Imf::setGlobalThreadCount(int(std::max(1u, std::thread::hardware_concurrency())));
+            // A header may claim any data window, and the file is opened (its table of chunk offsets
+            // allocated per line) before a check of ours could run: OpenEXR's own sanity check refuses
+            // a window wider or taller than the film may be.
+            Imf::Header::setMaxImageSize(kMaxImageSide, kMaxImageSide);
             return true;
         }();
         Imf::InputFile file(path.c_str());
         const Imath::Box2i dw = file.header().dataWindow();
+        const int64_t width = int64_t(dw.max.x) - dw.min.x + 1, height = int64_t(dw.max.y) - dw.min.y + 1;
+        if (width < 1 || height < 1 || width > kMaxImageSide || height > kMaxImageSide)
+            fail(path, fmt::format("its data window is {}x{} pixels; at most {} on a side are read (as a film's)", width,
+                                   height, kMaxImageSide));
+        // Before the pixels are allocated: a damaged header asking for a window the file's data does not
+        // cover would otherwise cost gigabytes of zeros before the read fails.
+        if (!file.isComplete()) fail(path, "the file is incomplete: its chunks do not cover its data window (truncated or damaged)");
         std::vector<std::string> names = pick_exr_channels(file.header().channels(), path);
         Image img(dw.max.x - dw.min.x + 1, dw.max.y - dw.min.y + 1, int(names.size()));
         const size_t xstride = sizeof(float) * img.channels, ystride = xstride * img.width;

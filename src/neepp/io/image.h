@@ -26,6 +26,9 @@ struct Image {
     int color_channels() const { return has_alpha() ? channels - 1 : channels; }  // 1 or 3
 };
 
+// The largest side of an image read or rendered (a film's, an OpenEXR file's data window): refused beyond.
+constexpr int kMaxImageSide = 1 << 15;
+
 // Reads EXR (linear; half or float; R,G,B[,A] or Y[,A] channels), PNG, JPEG, HDR, TGA, BMP. The format
 // is detected from the file's contents, not its name. Integer formats come back normalized to [0,1]
 // (byte * (1/255), as Dr.Jit's texture does) with srgb_encoded = true, as Mitsuba marks them (16-bit

@@ -5,7 +5,9 @@
 
 #include <algorithm>
 #include <charconv>
+#include <cfloat>
 #include <climits>
+#include <cstdio>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -35,6 +37,24 @@ const char *kind_name(XmlProperty::Kind kind) {
     return "?";
 }
 
+namespace {
+
+std::string number_text(double v) {
+    char buf[32];
+    std::snprintf(buf, sizeof buf, "%g", v);
+    return buf;
+}
+
+}  // namespace
+
+std::string NumberRange::describe() const {
+    if (max == HUGE_VAL && min == 0) return min_open ? "must be positive (> 0)" : "must be non-negative (>= 0)";
+    if (max == HUGE_VAL) return std::string(min_open ? "must be > " : "must be >= ") + number_text(min);
+    if (min == -HUGE_VAL) return std::string(max_open ? "must be < " : "must be <= ") + number_text(max);
+    return std::string("out of range: must be in ") + (min_open ? "(" : "[") + number_text(min) + ", " + number_text(max) +
+           (max_open ? ")" : "]");
+}
+
 // ---------------------------------------------------------------------------------------------
 // XmlNode accessors
 // ---------------------------------------------------------------------------------------------
@@ -58,7 +78,8 @@ float as_float(const XmlNode &n, const std::string &prop, const XmlProperty &p) 
 int as_int(const XmlNode &n, const std::string &prop, const XmlProperty &p) {
     if (p.kind != Kind::Integer) wrong_kind(n, prop, p, "integer");
     if (p.i < INT_MIN || p.i > INT_MAX)
-        throw SceneError(n.file, p.line, "property \"" + prop + "\": " + std::to_string(p.i) + " is out of range");
+        throw n.property_error(prop, "out of the range of an integer here (" + std::to_string(INT_MIN) + " to " +
+                                         std::to_string(INT_MAX) + ")");
     return int(p.i);
 }
 
@@ -72,16 +93,35 @@ std::string as_string(const XmlNode &n, const std::string &prop, const XmlProper
     return p.s;
 }
 
+// The bounds of a colour beyond being finite. Mitsuba 3 refuses an RGB reflectance outside [0, 1] (its
+// srgb texture) and reads floats and spectra unchecked; a negative one means nothing anywhere (a negative
+// emission renders a negative image), so it is refused too.
+void check_color(const XmlNode &n, const std::string &prop, const XmlProperty &p, ColorRange range) {
+    if (range == ColorRange::Signed) return;
+    const char *what = n.tag == "emitter" ? "an emission cannot be negative" : "it cannot be negative";
+    if (p.kind == Kind::Spectrum) {
+        for (double v : p.spectrum.values)
+            if (v < 0) throw n.property_error(prop, std::string("a spectrum with a negative value: ") + what);
+        return;
+    }
+    const Color c = p.kind == Kind::RGB ? Color(p.v) : Color(float(p.f));
+    if (c.x < 0 || c.y < 0 || c.z < 0) throw n.property_error(prop, std::string("negative: ") + what);
+    if (range == ColorRange::Reflectance && p.kind == Kind::RGB && (c.x > 1 || c.y > 1 || c.z > 1))
+        throw n.property_error(prop, "an RGB reflectance must be within [0, 1] (as in Mitsuba 3)");
+}
+
 // Mitsuba accepts a plain float wherever a spectrum is expected and treats it as a grey constant. A
 // <spectrum> becomes RGB as Mitsuba's RGB variants make it: as emission when an emitter reads it.
-Color as_rgb(const XmlNode &n, const std::string &prop, const XmlProperty &p, bool unbounded = false) {
+Color as_rgb(const XmlNode &n, const std::string &prop, const XmlProperty &p, bool unbounded = false,
+             ColorRange range = ColorRange::Reflectance) {
+    if (p.kind != Kind::RGB && p.kind != Kind::Float && p.kind != Kind::Spectrum)
+        wrong_kind(n, prop, p, "rgb, spectrum or float");
+    check_color(n, prop, p, n.tag == "emitter" && range == ColorRange::Reflectance ? ColorRange::NonNegative : range);
     if (p.kind == Kind::RGB) return p.v;
     if (p.kind == Kind::Float) return Color(float(p.f));
-    if (p.kind == Kind::Spectrum)
-        return spectrum_to_rgb(p.spectrum, n.tag == "emitter" ? SpectrumUse::Emission
-                                           : unbounded        ? SpectrumUse::Unbounded
-                                                              : SpectrumUse::Reflectance);
-    wrong_kind(n, prop, p, "rgb, spectrum or float");
+    return spectrum_to_rgb(p.spectrum, n.tag == "emitter" ? SpectrumUse::Emission
+                                       : unbounded        ? SpectrumUse::Unbounded
+                                                          : SpectrumUse::Reflectance);
 }
 
 Vec3 as_vector(const XmlNode &n, const std::string &prop, const XmlProperty &p) {
@@ -105,12 +145,29 @@ SceneError XmlNode::error(const std::string &problem) const {
     return SceneError(file, line, "<" + tag + (type.empty() ? "" : " type=\"" + type + "\"") + ">: " + problem);
 }
 
+SceneError XmlNode::property_error(const std::string &prop, const std::string &problem) const {
+    const std::string element = "<" + tag + (type.empty() ? "" : " type=\"" + type + "\"") + ">: property \"" + prop + "\"";
+    auto it = props.find(prop);
+    if (it == props.end()) return SceneError(file, line, element + ": " + problem);
+    return SceneError(file, it->second.line, element + " = \"" + it->second.text + "\": " + problem);
+}
+
 float XmlNode::get_float(const std::string &prop) const { return as_float(*this, prop, *find(prop, true)); }
 float XmlNode::get_float(const std::string &prop, float def) const {
     const XmlProperty *p = find(prop, false);
     return p ? as_float(*this, prop, *p) : def;
 }
+float XmlNode::get_float(const std::string &prop, float def, const NumberRange &range) const {
+    const float v = get_float(prop, def);
+    if (has(prop) && !range.contains(v)) throw property_error(prop, range.describe());
+    return v;
+}
 int XmlNode::get_int(const std::string &prop) const { return as_int(*this, prop, *find(prop, true)); }
+int XmlNode::get_int(const std::string &prop, int def, const NumberRange &range) const {
+    const int v = get_int(prop, def);
+    if (has(prop) && !range.contains(v)) throw property_error(prop, range.describe());
+    return v;
+}
 int XmlNode::get_int(const std::string &prop, int def) const {
     const XmlProperty *p = find(prop, false);
     return p ? as_int(*this, prop, *p) : def;
@@ -130,9 +187,9 @@ Color XmlNode::get_rgb(const std::string &prop, const Color &def) const {
     const XmlProperty *p = find(prop, false);
     return p ? as_rgb(*this, prop, *p) : def;
 }
-Color XmlNode::get_unbounded_rgb(const std::string &prop, const Color &def) const {
+Color XmlNode::get_unbounded_rgb(const std::string &prop, const Color &def, ColorRange range) const {
     const XmlProperty *p = find(prop, false);
-    return p ? as_rgb(*this, prop, *p, true) : def;
+    return p ? as_rgb(*this, prop, *p, true, range == ColorRange::Reflectance ? ColorRange::NonNegative : range) : def;
 }
 Vec3 XmlNode::get_vector(const std::string &prop) const { return as_vector(*this, prop, *find(prop, true)); }
 Vec3 XmlNode::get_vector(const std::string &prop, const Vec3 &def) const {
@@ -432,13 +489,25 @@ private:
         std::string name = el.attribute("name").value();
         claim_name(src, el, parent, name);
         p.line = src.line_of(el);
+        if (p.text.empty()) p.text = el.attribute("value") ? el.attribute("value").value() : el.attribute("filename").value();
         parent.props.emplace(name, std::move(p));
     }
 
+    // Every number in a scene becomes a 32-bit float: one that is not finite (nan, inf), or that overflows a
+    // float (1e39), would render garbage or nothing without a word, so it is refused here, naming the
+    // property (the element's, or for a step of a <transform> the transform's) and the value.
     double number(const SourceFile &src, pugi::xml_node el, std::string_view text, const char *what) {
         double v;
         if (!parse_number(text, v))
             fail(src, el, "could not parse " + std::string(what) + " value \"" + std::string(text) + "\" in <" + el.name() + ">");
+        if (!std::isfinite(v) || std::abs(v) > FLT_MAX) {
+            pugi::xml_attribute name = el.attribute("name");
+            if (!name) name = el.parent().attribute("name");
+            const std::string where = name ? "property \"" + std::string(name.value()) + "\": " : std::string();
+            fail(src, el, where + "<" + el.name() + "> value \"" + std::string(trim(text)) + "\" " +
+                              (std::isfinite(v) ? "overflows a 32-bit float (largest " + number_text(FLT_MAX) + ")"
+                                                : std::string("is not a finite number")));
+        }
         return v;
     }
 
@@ -496,6 +565,12 @@ private:
             p.kind = Kind::Transform;
             for (pugi::xml_node op : el.children())
                 if (op.type() == pugi::node_element) p.xf = transform_op(src, op) * p.xf;
+            // Each step is finite; their product can still overflow (two scales by 1e30).
+            for (const auto &row : p.xf.matrix.m)
+                for (float v : row)
+                    if (!std::isfinite(v))
+                        fail(src, el, "property \"" + std::string(el.attribute("name").value()) +
+                                          "\": the <transform>'s steps compose to a matrix that is not finite");
             set_prop(src, el, parent, std::move(p));
             return;
         }
@@ -504,7 +579,9 @@ private:
             check_attributes(src, el, {"!name", "!value"});
             p.kind = Kind::Integer;
             if (!parse_integer(el.attribute("value").value(), p.i))
-                fail(src, el, "could not parse integer value \"" + std::string(el.attribute("value").value()) + "\"");
+                fail(src, el, "property \"" + std::string(el.attribute("name").value()) +
+                                  "\": could not parse integer value \"" + std::string(el.attribute("value").value()) +
+                                  "\" (a whole number that fits 64 bits)");
         } else if (tag == "float") {
             check_attributes(src, el, {"!name", "!value"});
             p.kind = Kind::Float;
@@ -535,8 +612,13 @@ private:
             try {
                 p.spectrum = value ? parse_spectrum(value.value()) : read_spectrum_file(parent.resolve_path(file.value()));
             } catch (const std::exception &e) {
-                fail(src, el, std::string("<spectrum>: ") + e.what());
+                fail(src, el, "property \"" + std::string(el.attribute("name").value()) + "\": <spectrum>: " + e.what());
             }
+            for (double v : p.spectrum.values)
+                if (!(std::abs(v) <= FLT_MAX))
+                    fail(src, el, "property \"" + std::string(el.attribute("name").value()) + "\": <spectrum> value \"" +
+                                      std::string(value ? value.value() : file.value()) + "\" holds " + number_text(v) +
+                                      ", which overflows a 32-bit float (largest " + number_text(FLT_MAX) + ")");
         } else if (tag == "vector" || tag == "point") {
             check_attributes(src, el, {"!name", "value", "x", "y", "z"});
             p.kind = tag == "vector" ? Kind::Vector : Kind::Point;

@@ -1,6 +1,7 @@
 // Mitsuba 3 XML scene files parsed into a generic tree of nodes with typed properties. A separate
 // factory turns the tree into renderer objects; this layer only knows the file format.
 #pragma once
+#include <cmath>
 #include <cstdint>
 #include <map>
 #include <memory>
@@ -24,11 +25,33 @@ struct XmlProperty {
     Vec3 v;  // RGB, Vector and Point
     Transform xf;
     Spectrum spectrum;
+    std::string text;  // the value as written (after $ substitution), for messages
     int line = 0;
     mutable bool used = false;  // set by XmlNode's getters, so unread properties can be reported
 };
 
 const char *kind_name(XmlProperty::Kind kind);
+
+// The values a numeric property can mean. A read outside them is an error naming the property and its value
+// as written; a value that is not finite never gets that far (the parser refuses it).
+struct NumberRange {
+    double min = -HUGE_VAL, max = HUGE_VAL;
+    bool min_open = false, max_open = false;
+    static NumberRange at_least(double v) { return {v, HUGE_VAL, false, false}; }
+    static NumberRange above(double v) { return {v, HUGE_VAL, true, false}; }
+    static NumberRange between(double lo, double hi) { return {lo, hi, false, false}; }
+    bool contains(double v) const {
+        return (min_open ? v > min : v >= min) && (max_open ? v < max : v <= max);
+    }
+    std::string describe() const;  // "must be >= 0", "must be in (0, 1]"
+};
+
+// How a colour property is bounded beyond being finite.
+enum class ColorRange {
+    Reflectance,  // an RGB within [0, 1] (Mitsuba 3's rule), a float or a spectrum not negative
+    NonNegative,  // an emission, an index of refraction, a roughness, an absorption
+    Signed,       // an angle
+};
 
 struct XmlNode {
     std::string tag;   // shape, bsdf, texture, emitter, sensor, film, rfilter, sampler, integrator, medium, ...
@@ -55,18 +78,22 @@ struct XmlNode {
     // absent. All throw a SceneError naming file:line and the property on a type mismatch.
     float get_float(const std::string &prop) const;
     float get_float(const std::string &prop, float def) const;  // an integer is accepted too
+    float get_float(const std::string &prop, float def, const NumberRange &range) const;
     int get_int(const std::string &prop) const;
     int get_int(const std::string &prop, int def) const;
+    int get_int(const std::string &prop, int def, const NumberRange &range) const;
     bool get_bool(const std::string &prop) const;
     bool get_bool(const std::string &prop, bool def) const;
     std::string get_string(const std::string &prop) const;
     std::string get_string(const std::string &prop, const std::string &def) const;
     // rgb, spectrum, or float (grey); a spectrum as a reflectance (within [0, 1]), or as an emission on
-    // an <emitter>.
+    // an <emitter>. Bounded as a reflectance (ColorRange::Reflectance), or on an <emitter> as an emission
+    // (not negative).
     Color get_rgb(const std::string &prop) const;
     Color get_rgb(const std::string &prop, const Color &def) const;
-    // The same for a property Mitsuba reads unbounded (a conductor's eta and k): a spectrum only kept >= 0.
-    Color get_unbounded_rgb(const std::string &prop, const Color &def) const;
+    // The same for a property Mitsuba reads unbounded (a conductor's eta and k): a spectrum only kept >= 0,
+    // and the value bounded by `range` only.
+    Color get_unbounded_rgb(const std::string &prop, const Color &def, ColorRange range = ColorRange::NonNegative) const;
     Vec3 get_vector(const std::string &prop) const;  // <vector> or <point>
     Vec3 get_vector(const std::string &prop, const Vec3 &def) const;
     Transform get_transform(const std::string &prop, const Transform &def = Transform()) const;
@@ -82,6 +109,9 @@ struct XmlNode {
     std::vector<std::string> unused_properties() const;
     // An error located at this element: "file:line: <tag type="..."> problem".
     SceneError error(const std::string &problem) const;
+    // An error located at the property's own line: "file:line: <tag type="...">: property "p" = "value as
+    // written": problem" (at the element's line, without the value, when the property is absent).
+    SceneError property_error(const std::string &prop, const std::string &problem) const;
 
 private:
     // Marks the property used; null when absent and not required.

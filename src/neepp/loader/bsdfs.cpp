@@ -49,7 +49,9 @@ std::pair<TexturePtr, TexturePtr> roughness_params(Factories &f, const XmlNode &
 // Mitsuba's conductor parameters: a named `material` or explicit `eta`/`k`.
 std::pair<TexturePtr, TexturePtr> conductor_ior(Factories &f, const XmlNode &node) {
     std::string material = node.get_string("material", "none");
-    if (node.has("eta") || node.child("eta")) {
+    // Without a material, eta and k are read with Mitsuba's defaults (those of "none"), so that a k given
+    // alone is read (and checked) as Mitsuba reads it.
+    if (node.has("eta") || node.child("eta") || material == "none") {
         if (material != "none") throw node.error("give either 'material' or 'eta'/'k', not both");
         return {f.texture_param(node, "eta", Color(0.f), true), f.texture_param(node, "k", Color(1.f), true)};
     }
@@ -84,21 +86,19 @@ PrincipledParams Factories::principled_params(const XmlNode &node) {
     p.clearcoat_gloss = texture_param(node, "clearcoat_gloss", Color(0.f));
     if (node.has("eta") && node.has("specular")) throw node.error("give either 'eta' or 'specular', not both");
     if (node.has("eta")) {
-        p.eta = node.get_float("eta");
-        if (!(p.eta > 0.f)) throw node.error("'eta' must be positive");
+        p.eta = node.get_float("eta", 1.5f, NumberRange::above(0));
         // A transmissive interface of IOR 1 is degenerate: Mitsuba moves it off 1.
         if (p.spec_trans && p.eta == 1.f) p.eta = 1.001f;
     } else {
-        float specular = node.get_float("specular", 0.5f);
-        if (!(specular >= 0.f && specular < 12.5f)) throw node.error("'specular' must be in [0, 12.5)");
+        // 12.5 would make the IOR infinite.
+        float specular = node.get_float("specular", 0.5f, NumberRange{0, 12.5, false, true});
         if (p.spec_trans && specular == 0.f) specular = 1e-3f;
         p.eta = principled_eta_from_specular(specular);
     }
-    p.main_specular_sampling_rate = node.get_float("main_specular_sampling_rate", 1.f);
-    p.clearcoat_sampling_rate = node.get_float("clearcoat_sampling_rate", 1.f);
-    p.diffuse_reflectance_sampling_rate = node.get_float("diffuse_reflectance_sampling_rate", 1.f);
-    for (float rate : {p.main_specular_sampling_rate, p.clearcoat_sampling_rate, p.diffuse_reflectance_sampling_rate})
-        if (!(rate >= 0.f)) throw node.error("sampling rates must be non-negative");
+    const NumberRange rate = NumberRange::at_least(0);
+    p.main_specular_sampling_rate = node.get_float("main_specular_sampling_rate", 1.f, rate);
+    p.clearcoat_sampling_rate = node.get_float("clearcoat_sampling_rate", 1.f, rate);
+    p.diffuse_reflectance_sampling_rate = node.get_float("diffuse_reflectance_sampling_rate", 1.f, rate);
     if (!(p.main_specular_sampling_rate > 0.f))
         throw node.error("'main_specular_sampling_rate' must be positive (the specular lobes would never be sampled)");
     return p;
@@ -116,13 +116,11 @@ PrincipledThinParams Factories::principled_thin_params(const XmlNode &node) {
     p.sheen_tint = principled_lobe_param(node, "sheen_tint");
     p.flatness = principled_lobe_param(node, "flatness");
     p.diff_trans = principled_lobe_param(node, "diff_trans");
-    p.specular_reflectance_sampling_rate = node.get_float("specular_reflectance_sampling_rate", 1.f);
-    p.specular_transmittance_sampling_rate = node.get_float("specular_transmittance_sampling_rate", 1.f);
-    p.diffuse_reflectance_sampling_rate = node.get_float("diffuse_reflectance_sampling_rate", 1.f);
-    p.diffuse_transmittance_sampling_rate = node.get_float("diffuse_transmittance_sampling_rate", 1.f);
-    for (float rate : {p.specular_reflectance_sampling_rate, p.specular_transmittance_sampling_rate,
-                       p.diffuse_reflectance_sampling_rate, p.diffuse_transmittance_sampling_rate})
-        if (!(rate >= 0.f)) throw node.error("sampling rates must be non-negative");
+    const NumberRange rate = NumberRange::at_least(0);
+    p.specular_reflectance_sampling_rate = node.get_float("specular_reflectance_sampling_rate", 1.f, rate);
+    p.specular_transmittance_sampling_rate = node.get_float("specular_transmittance_sampling_rate", 1.f, rate);
+    p.diffuse_reflectance_sampling_rate = node.get_float("diffuse_reflectance_sampling_rate", 1.f, rate);
+    p.diffuse_transmittance_sampling_rate = node.get_float("diffuse_transmittance_sampling_rate", 1.f, rate);
     if (!(p.diffuse_reflectance_sampling_rate > 0.f))
         throw node.error("'diffuse_reflectance_sampling_rate' must be positive (the diffuse lobe would never be sampled)");
     return p;
@@ -131,22 +129,23 @@ PrincipledThinParams Factories::principled_thin_params(const XmlNode &node) {
 // Mitsuba's hair: pigment concentrations or an absorption texture (scaled by `scale`), not both.
 HairParams Factories::hair_params(const XmlNode &node) {
     HairParams p;
-    p.longitudinal_roughness = node.get_float("longitudinal_roughness", p.longitudinal_roughness);
-    p.azimuthal_roughness = node.get_float("azimuthal_roughness", p.azimuthal_roughness);
+    const NumberRange roughness{0, 1, true, false};
+    p.longitudinal_roughness = node.get_float("longitudinal_roughness", p.longitudinal_roughness, roughness);
+    p.azimuthal_roughness = node.get_float("azimuthal_roughness", p.azimuthal_roughness, roughness);
     p.scale_tilt_deg = node.get_float("scale_tilt", p.scale_tilt_deg);
     const float int_ior = ior_param(node, "int_ior", 1.55f), ext_ior = ior_param(node, "ext_ior", 1.000277f);
     if (int_ior == ext_ior) throw node.error("'int_ior' and 'ext_ior' must differ");
     p.eta = int_ior / ext_ior;
     // Read whichever absorption is used, as Mitsuba does (a scale beside pigments is then merely unused).
-    p.sigma_a_scale = node.get_float("scale", 1.f);
+    p.sigma_a_scale = node.get_float("scale", 1.f, NumberRange::at_least(0));
     const bool pigments = node.has("eumelanin") || node.has("pheomelanin");
     if (node.has("sigma_a") || node.child("sigma_a")) {
         if (pigments) throw node.error("give either 'sigma_a' or the pigments 'eumelanin'/'pheomelanin', not both");
         p.sigma_a = texture_param(node, "sigma_a", Color(0.f), true);
     } else {
-        const float eumelanin = node.get_float("eumelanin", 1.3f), pheomelanin = node.get_float("pheomelanin", 0.2f);
-        if (!(eumelanin >= 0.f && pheomelanin >= 0.f) || !std::isfinite(eumelanin + pheomelanin))
-            throw node.error("pigment concentrations must be non-negative and finite");
+        const float eumelanin = node.get_float("eumelanin", 1.3f, NumberRange::at_least(0)),
+                    pheomelanin = node.get_float("pheomelanin", 0.2f, NumberRange::at_least(0));
+        if (!std::isfinite(eumelanin + pheomelanin)) throw node.error("pigment concentrations must be finite");
         p.sigma_a = constant_texture(hair_pigment_absorption(eumelanin, pheomelanin));
         p.sigma_a_scale = 1.f;
     }
@@ -162,9 +161,7 @@ float ior_param(const XmlNode &node, const std::string &name, float def) {
         if (!v) throw node.error("unknown index of refraction '" + s + "' for '" + name + "'");
         return *v;
     }
-    float v = node.get_float(name);
-    if (!(v > 0)) throw node.error("'" + name + "' must be positive");
-    return v;
+    return node.get_float(name, def, NumberRange::above(0));
 }
 
 BSDFPtr Factories::default_bsdf() {
@@ -227,7 +224,8 @@ BSDFPtr Factories::create_bsdf(const XmlNode &node) {
         b = std::make_shared<NullBSDF>();
     } else if (t == "polarizer") {
         // The polarizer's angle changes nothing for unpolarized light: read only so that it is not "unused".
-        texture_param(node, "theta", Color(0.f), true);
+        if (auto theta = node.child("theta")) texture(*theta);
+        else node.get_unbounded_rgb("theta", Color(0.f), ColorRange::Signed);
         b = std::make_shared<NullBSDF>(texture_param(node, "transmittance", Color(1.f)), 0.5f);
     } else if (t == "mask") {
         auto kids = nested(1, 1);
@@ -265,7 +263,7 @@ BSDFPtr Factories::create_bsdf(const XmlNode &node) {
                                           texture_param_or_null(node, "specular_reflectance"),
                                           node.get_bool("nonlinear", false));
     } else if (t == "roughplastic") {
-        b = std::make_shared<RoughPlasticBSDF>(distribution_param(node), node.get_float("alpha", 0.1f),
+        b = std::make_shared<RoughPlasticBSDF>(distribution_param(node), node.get_float("alpha", 0.1f, NumberRange::at_least(0)),
                                                ior_param(node, "int_ior", 1.49f), ior_param(node, "ext_ior", 1.000277f),
                                                texture_param(node, "diffuse_reflectance", Color(0.5f)),
                                                texture_param_or_null(node, "specular_reflectance"),
@@ -275,7 +273,7 @@ BSDFPtr Factories::create_bsdf(const XmlNode &node) {
         float eta;
         if (node.has("eta")) {
             if (node.has("int_ior") || node.has("ext_ior")) throw node.error("give either 'eta' or 'int_ior'/'ext_ior', not both");
-            eta = node.get_float("eta", 1.5f);
+            eta = node.get_float("eta", 1.5f, NumberRange::above(0));
         } else {
             eta = ior_param(node, "int_ior", 1.49f) / ior_param(node, "ext_ior", 1.000277f);
         }

@@ -131,6 +131,12 @@ void load_integrator(const XmlNode &node, RenderSettings &settings) {
     const std::vector<std::string> &known = supported_names("integrator");
     if (std::find(known.begin(), known.end(), n->type) == known.end() && !integrator_registered(n->type))
         throw n->error("unsupported integrator '" + n->type + "' (supported: " + supported_list("integrator") + ")");
+    // Mitsuba 3's bounds for the depths every path-building integrator reads (an integer of another kind is
+    // refused by the integrator's options).
+    if (n->has("max_depth") && n->props.at("max_depth").kind == XmlProperty::Kind::Integer)
+        n->get_int("max_depth", -1, NumberRange::at_least(-1));
+    if (n->has("rr_depth") && n->props.at("rr_depth").kind == XmlProperty::Kind::Integer)
+        n->get_int("rr_depth", 5, NumberRange::at_least(1));
     settings.integrator = n->type;
     settings.integrator_options.clear();
     const auto mapped = mitsuba_integrators().find(n->type);
@@ -138,6 +144,8 @@ void load_integrator(const XmlNode &node, RenderSettings &settings) {
     for (auto &[name, prop] : n->props) {
         prop.used = true;
         if (mapped != mitsuba_integrators().end() && mapped->second.noise_only.count(name)) {
+            // Sample counts: Mitsuba 3 reads them unsigned.
+            if (prop.kind == XmlProperty::Kind::Integer) n->get_int(name, 0, NumberRange::at_least(0));
             dropped.push_back(name);
             continue;
         }

@@ -7,6 +7,7 @@
 #include <set>
 
 #include <fmt/core.h>
+#include "neepp/io/image.h"
 #include "neepp/loader/factories.h"
 #include "neepp/loader/problems.h"
 
@@ -16,7 +17,7 @@ namespace loader {
 
 void load_fov(const XmlNode &sensor, Camera &cam) {
     if (sensor.has("fov")) {
-        cam.fov = sensor.get_float("fov");
+        cam.fov = sensor.get_float("fov", 0.f, NumberRange{0, 180, true, true});
         cam.fov_axis = sensor.get_string("fov_axis", "x");
         return;
     }
@@ -39,20 +40,23 @@ namespace {
 
 void load_film(const XmlNode &film, Scene &scene) {
     if (film.type != "hdrfilm") throw film.error("unsupported film '" + film.type + "' (supported: " + supported_list("film") + ")");
-    scene.camera.width = film.get_int("width", 768);
-    scene.camera.height = film.get_int("height", 576);
+    constexpr int kMaxSide = kMaxImageSide;
+    const NumberRange side = NumberRange::between(1, kMaxSide);
+    scene.camera.width = film.get_int("width", 768, side);
+    scene.camera.height = film.get_int("height", 576, side);
     // Mitsuba's film also carries output settings that do not change the image.
     film.get_string("file_format", "openexr");
     film.get_string("pixel_format", "rgb");
     film.get_string("component_format", "float16");
     film.get_bool("banner", false);
-    constexpr int kMaxSide = 1 << 15;
     if (scene.camera.width < 1 || scene.camera.height < 1 || scene.camera.width > kMaxSide || scene.camera.height > kMaxSide)
         throw film.error(fmt::format("film size {}x{} is out of range (1 to {} pixels per side)", scene.camera.width,
                                      scene.camera.height, kMaxSide));
     // Mitsuba's crop window: the image is that part of the film.
-    const int cx = film.get_int("crop_offset_x", 0), cy = film.get_int("crop_offset_y", 0);
-    const int cw = film.get_int("crop_width", scene.camera.width - cx), ch = film.get_int("crop_height", scene.camera.height - cy);
+    const int cx = film.get_int("crop_offset_x", 0, NumberRange::between(0, scene.camera.width - 1)),
+              cy = film.get_int("crop_offset_y", 0, NumberRange::between(0, scene.camera.height - 1));
+    const int cw = film.get_int("crop_width", scene.camera.width - cx, NumberRange::between(1, scene.camera.width - cx)),
+              ch = film.get_int("crop_height", scene.camera.height - cy, NumberRange::between(1, scene.camera.height - cy));
     if (cx != 0 || cy != 0 || cw != scene.camera.width || ch != scene.camera.height) {
         try {
             scene.camera.crop(cx, cy, cw, ch);
@@ -64,10 +68,12 @@ void load_film(const XmlNode &film, Scene &scene) {
         if (child->tag != "rfilter") throw child->error("unexpected <" + child->tag + "> inside the film");
         RenderSettings &s = scene.settings;
         s.rfilter = child->type;
-        if (s.rfilter == "box") s.rfilter_radius = child->get_float("radius", 0.5f);
-        else if (s.rfilter == "tent") s.rfilter_radius = child->get_float("radius", 1.f);
+        // A filter wider than 16 pixels is no scene's intent, and each sample would touch thousands of pixels.
+        const NumberRange radius{0, 16, true, false};
+        if (s.rfilter == "box") s.rfilter_radius = child->get_float("radius", 0.5f, radius);
+        else if (s.rfilter == "tent") s.rfilter_radius = child->get_float("radius", 1.f, radius);
         else if (s.rfilter == "gaussian") {
-            s.rfilter_stddev = child->get_float("stddev", 0.5f);
+            s.rfilter_stddev = child->get_float("stddev", 0.5f, NumberRange{0, 4, true, false});
             s.rfilter_radius = 4.f * s.rfilter_stddev;
         } else {
             throw child->error("unsupported reconstruction filter '" + s.rfilter + "' (box, tent, gaussian)");
@@ -85,8 +91,9 @@ void load_sampler(const XmlNode &sampler, RenderSettings &settings) {
         throw sampler.error("unsupported sampler '" + sampler.type + "' (supported: " + supported_list("sampler") + ")");
     settings.sampler = sampler.type;
     settings.spp = sampler.get_int("sample_count", 4);
-    settings.seed = uint64_t(sampler.get_int("seed", 0));
-    if (settings.spp < 1) throw sampler.error("sample_count must be at least 1");
+    if (settings.spp < 1) throw sampler.property_error("sample_count", "sample_count must be at least 1");
+    // Mitsuba 3 reads the seed as an unsigned integer and refuses a negative one.
+    settings.seed = uint64_t(sampler.get_int("seed", 0, NumberRange::at_least(0)));
     loader::warn_unused(sampler);
 }
 
@@ -94,6 +101,8 @@ void load_thin_lens(const XmlNode &sensor, Camera &cam) {
     // Mitsuba's thinlens requires the radius, and refuses a camera transform that scales (the lens would
     // no longer be a disk of that radius).
     cam.aperture_radius = sensor.get_float("aperture_radius");
+    if (!(cam.aperture_radius >= 0)) throw sensor.property_error("aperture_radius", "aperture_radius must be zero or more");
+    if (!(cam.focus_distance > 0)) throw sensor.property_error("focus_distance", "focus_distance must be greater than zero");
     if (!cam.to_world.preserves_lengths(1e-3f))
         throw sensor.error("the thinlens sensor's to_world must not scale (Mitsuba 3 refuses scale factors there)");
     if (cam.aperture_radius == 0)  // Mitsuba warns too, and renders with a radius of float epsilon: a pinhole
@@ -108,7 +117,9 @@ void load_sensor(const XmlNode &sensor, Scene &scene) {
     if (sensor.type == "orthographic") cam.projection = Projection::Orthographic;
     else loader::load_fov(sensor, cam);
     cam.near_clip = sensor.get_float("near_clip", 1e-2f);
+    if (!(cam.near_clip > 0)) throw sensor.property_error("near_clip", "near_clip must be greater than zero");
     cam.far_clip = sensor.get_float("far_clip", 1e4f);
+    if (!(cam.far_clip > cam.near_clip)) throw sensor.property_error("far_clip", "far_clip must be greater than near_clip");
     // Every Mitsuba projective sensor reads it; only a lens uses it.
     cam.focus_distance = sensor.get_float("focus_distance", cam.far_clip);
     if (sensor.type == "thinlens") load_thin_lens(sensor, cam);
@@ -150,12 +161,14 @@ std::unique_ptr<Scene> read_scene(const std::string &path, const std::map<std::s
     for (const auto &node : root->children) attempt([&] {  // when checking, a broken element is left out
         const std::string &tag = node->tag;
         if (tag == "shape") {
+            loader::check_shape_numbers(*node);
             factories.shape(*node, *scene);
         } else if (tag == "emitter" && node->type == "area") {
             // Made by the shapes that <ref> it, each its own light, as in Mitsuba.
             if (!in_shapes.count(node.get()))
                 throw node->error("this 'area' emitter is attached to no shape (nest it in a <shape>, or <ref> it from one)");
         } else if (tag == "emitter") {
+            loader::check_emitter_numbers(*node);
             factories.emitter(*node, *scene);
         } else if (tag == "sensor") {
             if (have_sensor) throw node->error("only one sensor is supported");
