@@ -71,12 +71,6 @@ void warn_unused(const XmlNode &node);
 // A perspective projection's angle of view (a perspective sensor's, a projector's): fov along fov_axis,
 // or Mitsuba 3's default from focal_length.
 void load_fov(const XmlNode &node, Camera &cam);
-// The bounds of a shape's numbers (a sphere's or cylinder's radius, a serialized shape_index) and its area
-// emitter's, and of an emitter's own (a scale, a spot's angles), each refused naming the property and its
-// value: what the builders in shapes.cpp read, checked before they build (read_scene calls these on every
-// shape and emitter of the scene).
-void check_shape_numbers(const XmlNode &node);
-void check_emitter_numbers(const XmlNode &node);
 // An IOR given as a number or a name from Mitsuba's table ("bk7", "air"...).
 float ior_param(const XmlNode &node, const std::string &name, float def);
 

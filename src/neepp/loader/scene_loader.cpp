@@ -161,14 +161,12 @@ std::unique_ptr<Scene> read_scene(const std::string &path, const std::map<std::s
     for (const auto &node : root->children) attempt([&] {  // when checking, a broken element is left out
         const std::string &tag = node->tag;
         if (tag == "shape") {
-            loader::check_shape_numbers(*node);
             factories.shape(*node, *scene);
         } else if (tag == "emitter" && node->type == "area") {
             // Made by the shapes that <ref> it, each its own light, as in Mitsuba.
             if (!in_shapes.count(node.get()))
                 throw node->error("this 'area' emitter is attached to no shape (nest it in a <shape>, or <ref> it from one)");
         } else if (tag == "emitter") {
-            loader::check_emitter_numbers(*node);
             factories.emitter(*node, *scene);
         } else if (tag == "sensor") {
             if (have_sensor) throw node->error("only one sensor is supported");

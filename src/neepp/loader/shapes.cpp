@@ -107,7 +107,7 @@ MeshData cylinder_mesh() {
 // Mitsuba's cylinder frame: p0 to p1, of the given radius, inside the shape's to_world.
 Transform cylinder_frame(const XmlNode &node) {
     const Vec3 p0 = node.get_vector("p0", Vec3(0, 0, 0)), p1 = node.get_vector("p1", Vec3(0, 0, 1));
-    const float radius = node.get_float("radius", 1.f), length = norm(p1 - p0);
+    const float radius = node.get_float("radius", 1.f, NumberRange::above(0)), length = norm(p1 - p0);
     if (!(radius > 0) || !std::isfinite(radius)) throw node.error("cylinder radius must be positive and finite");
     if (!(length > 0) || !std::isfinite(length)) throw node.error("cylinder p0 and p1 must be distinct finite points");
     const Frame f(normalize(p1 - p0));
@@ -270,7 +270,7 @@ std::unique_ptr<Shape> Factories::build_shape(const XmlNode &node, const XmlNode
     try {
         if (t == "obj" || t == "ply" || t == "serialized") {
             std::string path = node.resolve_path(node.get_string("filename"));
-            const int shape_index = t == "serialized" ? node.get_int("shape_index", 0) : 0;
+            const int shape_index = t == "serialized" ? node.get_int("shape_index", 0, NumberRange::at_least(0)) : 0;
             MeshData mesh;
             try {
                 mesh = t == "obj" ? read_obj(path) : t == "ply" ? read_ply(path) : read_serialized(path, shape_index);
@@ -299,7 +299,7 @@ std::unique_ptr<Shape> Factories::build_shape(const XmlNode &node, const XmlNode
         } else if (t == "sphere") {
             auto sphere = std::make_unique<Sphere>();
             sphere->center = node.get_vector("center", Vec3(0.f));
-            sphere->radius = node.get_float("radius", 1.f);
+            sphere->radius = node.get_float("radius", 1.f, NumberRange::above(0));
             if (!(sphere->radius > 0) || !std::isfinite(sphere->radius)) throw node.error("sphere radius must be positive and finite");
             sphere->transform(to_world);
             s = std::move(sphere);
@@ -355,7 +355,8 @@ void Factories::emitter(const XmlNode &node, Scene &scene) {
         }
         if (img.srgb_encoded)
             for (float &v : img.data) v = srgb_to_linear(v);
-        float scale = node.get_float("scale", 1.f);
+        // A negative scale is a negative emission: it would render a negative image (Mitsuba 3 does).
+        float scale = node.get_float("scale", 1.f, NumberRange::at_least(0));
         scene.add_light(std::make_unique<EnvironmentMapLight>(std::move(img), node.get_transform("to_world"), scale));
     } else if (t == "constant") {
         scene.add_light(std::make_unique<ConstantEnvironmentLight>(node.get_rgb("radiance", Color(1.f))));
@@ -373,8 +374,8 @@ void Factories::emitter(const XmlNode &node, Scene &scene) {
             throw node.error(e.what());
         }
     } else if (t == "spot") {
-        const float cutoff = node.get_float("cutoff_angle", 20.f);
-        const float beam = node.get_float("beam_width", cutoff * 3.f / 4.f);
+        const float cutoff = node.get_float("cutoff_angle", 20.f, NumberRange{0, 180, true, false});
+        const float beam = node.get_float("beam_width", cutoff * 3.f / 4.f, NumberRange{0, cutoff, false, true});
         try {
             scene.add_light(std::make_unique<SpotLight>(node.get_transform("to_world"), node.get_rgb("intensity", Color(1.f)),
                                                         cutoff, beam, texture_param_or_null(node, "texture")));
@@ -394,7 +395,7 @@ void Factories::emitter(const XmlNode &node, Scene &scene) {
             frame.width = frame.height = 1;
         }
         try {
-            scene.add_light(std::make_unique<ProjectorLight>(frame, irradiance, node.get_float("scale", 1.f)));
+            scene.add_light(std::make_unique<ProjectorLight>(frame, irradiance, node.get_float("scale", 1.f, NumberRange::at_least(0))));
         } catch (const std::invalid_argument &e) {
             throw node.error(e.what());
         }
