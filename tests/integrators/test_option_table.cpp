@@ -21,7 +21,7 @@ std::set<std::string> listed(const std::string &integrator) {
 }  // namespace
 
 TEST(OptionTable, EveryListedOptionIsAcceptedWithItsDefault) {
-    ASSERT_EQ(integrator_docs().size(), 4u);
+    ASSERT_EQ(integrator_docs().size(), 5u);
     for (const IntegratorDoc &d : integrator_docs()) {
         EXPECT_FALSE(d.description.empty()) << d.name;
         for (const OptionDoc &o : d.options) {
@@ -51,6 +51,7 @@ TEST(OptionTable, EveryOptionTheFactoryReadsIsListed) {
         {"path", {{"shadow_rays", "neepp-adaptive"}, {"light_sampler", "visibility"}}},
         {"path", {{"shadow_rays", "neepp"}, {"nee", "true"}}},
         {"path", {{"ris", "8"}}},
+        {"volpath", {{"shadow_rays", "neepp-adaptive"}, {"light_sampler", "visibility"}}},
         {"bdpt", {{"light_paths", "neepp"}, {"shadow_rays", "neepp-adaptive"}}},
         {"bdpt", {{"strategy", "1,2"}, {"strategy_weight", "none"}}},
         {"light", {{"shadow_rays", "neepp-adaptive"}}},

@@ -30,8 +30,8 @@ TEST(IntegratorMapping, MitsubasIntegratorsRenderAsTheirEquivalent) {
         {R"(<integrator type="path"><integer name="max_depth" value="5"/></integrator>)", "path", {{"max_depth", "5"}}},
         {R"(<integrator type="prb"><integer name="max_depth" value="7"/></integrator>)", "path", {{"max_depth", "7"}}},
         {R"(<integrator type="prb_basic"/>)", "path", {}},
-        {R"(<integrator type="volpath"><integer name="rr_depth" value="3"/></integrator>)", "path", {{"rr_depth", "3"}}},
-        {R"(<integrator type="volpathmis"/>)", "path", {}},
+        {R"(<integrator type="volpath"><integer name="rr_depth" value="3"/></integrator>)", "volpath", {{"rr_depth", "3"}}},
+        {R"(<integrator type="volpathmis"/>)", "volpath", {}},
         {R"(<integrator type="prb_projective"><integer name="max_depth" value="4"/><integer name="sppi" value="0"/>
             <string name="guiding" value="grid"/></integrator>)", "path", {{"max_depth", "4"}}},
         {R"(<integrator type="direct_projective"><integer name="sppc" value="16"/><boolean name="guiding_proj" value="false"/>
@@ -50,7 +50,7 @@ TEST(IntegratorMapping, MitsubasIntegratorsRenderAsTheirEquivalent) {
          "path", {{"max_depth", "3"}}},
         {R"(<integrator type="aov"><string name="aovs" value="d:depth"/><integrator type="volpath" name="a">
             <integer name="rr_depth" value="2"/></integrator><integrator type="direct" name="b"/></integrator>)",
-         "path", {{"rr_depth", "2"}}},
+         "volpath", {{"rr_depth", "2"}}},
         {R"(<integrator type="aov"><string name="aovs" value="d:depth"/>
             <integrator type="moment"><integrator type="direct"/></integrator></integrator>)",
          "path", {{"max_depth", "2"}}},

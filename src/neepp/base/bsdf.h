@@ -72,6 +72,11 @@ public:
     virtual BSDFSample sample(const BSDFContext &ctx, const SurfaceInteraction &si, const Vec3 &wi, float u1,
                               Vec2 u2) const = 0;
     virtual uint32_t flags() const = 0;
+    // What passes straight through the surface, not scattered, for light arriving from wi (Mitsuba's
+    // eval_null_transmission): what a ray toward a light through a participating medium keeps where it
+    // crosses the surface. 0 for a surface opaque to such rays, which most are; the null BSDF's
+    // transmittance, a thin dielectric's 1 - R, a mask's 1 - opacity.
+    virtual Color null_transmission(const SurfaceInteraction &si, const Vec3 &wi) const { return Color(0.f); }
     // Cache prefetch of the texture data that evaluating or sampling at si (seen from si.wi) will read.
     // A hint for batched integrators, issued well before shading; it never changes a result.
     virtual void prefetch(const SurfaceInteraction &si) const {}

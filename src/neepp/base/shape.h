@@ -21,6 +21,7 @@
 namespace neepp {
 
 class Light;
+class Medium;
 
 struct PositionSample {
     Vec3 p, n;      // point on the surface and its geometric normal
@@ -89,6 +90,11 @@ public:
     BSDFPtr bsdf;
     const Light *area_light = nullptr;  // set when the scene creates an area light for this shape
     bool flip_normals = false;
+    // The media inside and outside it (null: vacuum), for a shape that bounds one: a ray leaving its
+    // surface enters the interior where it goes against the geometric normal, the exterior along it.
+    const Medium *interior = nullptr, *exterior = nullptr;
+    bool is_medium_transition() const { return interior || exterior; }
+    const Medium *medium_toward(const Vec3 &d, const Vec3 &n) const { return dot(d, n) > 0 ? exterior : interior; }
     // Set by finalize() from the BSDF: whether hits need dp/du, dp/dv and a shading frame aligned with dp/du
     // (Mitsuba's), or, when the BSDF reads neither (BSDF::needs_tangents), only a frame around the normal;
     // and the BSDF's flags, which the path tracer asks at every vertex.

@@ -57,6 +57,9 @@ void BDPTIntegrator::prepare(const Scene &scene) {
     // neepp's light paths connect to a pinhole only (a lens point would be one more vertex to sample and
     // weigh in MIS).
     const std::string name = options_.light_tracer ? "light" : "bdpt";
+    if (scene.has_media())
+        throw std::invalid_argument(name + ": participating media are not supported by light paths yet; render this "
+                                           "scene with the volpath integrator");
     if (scene.camera.has_lens())
         throw std::invalid_argument(name + ": light paths cannot connect to the thinlens sensor in neepp (its lens "
                                            "is not sampled by light paths); render this scene with the path integrator");

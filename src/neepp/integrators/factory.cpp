@@ -89,8 +89,9 @@ std::unique_ptr<Integrator> make_bdpt(bool light_tracer, const Options &options)
     return std::make_unique<BDPTIntegrator>(o, std::move(shadow));
 }
 
-std::unique_ptr<PathIntegrator> make_path(const Options &options) {
+std::unique_ptr<PathIntegrator> make_path(const Options &options, bool volumetric) {
     PathOptions o;
+    o.volumetric = volumetric;
     o.max_depth = options.get_int("max_depth", o.max_depth);
     o.rr_depth = options.get_int("rr_depth", o.rr_depth);
     o.hide_emitters = options.get_bool("hide_emitters", o.hide_emitters);
@@ -98,7 +99,8 @@ std::unique_ptr<PathIntegrator> make_path(const Options &options) {
     o.light_sampler = options.get_string("light_sampler", o.light_sampler);
     check_light_sampler_name(o.light_sampler);
     o.within_light = options.get_string("within_light", o.within_light);
-    const std::string form = options.get_string("form", "fast");
+    // volpath has its reference form only, and resamples nothing (yet).
+    const std::string form = volumetric ? "reference" : options.get_string("form", "fast");
     if (form != "fast" && form != "reference")
         throw std::invalid_argument("form must be 'fast' or 'reference', not '" + form + "'");
     o.reference = form == "reference";
@@ -107,7 +109,7 @@ std::unique_ptr<PathIntegrator> make_path(const Options &options) {
         throw std::invalid_argument("within_light must be 'own' or 'visibility', not '" + o.within_light + "'");
     if (o.max_depth < -1 || o.max_depth == 0) throw std::invalid_argument("max_depth must be -1 or >= 1");
     if (o.rr_depth < 1) throw std::invalid_argument("rr_depth must be >= 1");
-    o.ris = options.get_int("ris", o.ris);
+    if (!volumetric) o.ris = options.get_int("ris", o.ris);
     if (o.ris < 1 || o.ris > PathOptions::kMaxCandidates)
         throw std::invalid_argument("ris must be in [1, " + std::to_string(PathOptions::kMaxCandidates) + "]");
     if (o.ris > 1) {
@@ -129,7 +131,7 @@ std::unique_ptr<PathIntegrator> make_path(const Options &options) {
 // neepp=auto: the candidates' options are the user's with each candidate's overrides; every candidate is
 // built once here, so that a bad option is reported before the scene loads, and an option counts as
 // unused only if no candidate reads it.
-std::unique_ptr<Integrator> make_auto_path(const Options &options) {
+std::unique_ptr<Integrator> make_auto_path(const Options &options, bool volumetric) {
     for (const char *key : {"light_sampler", "within_light", "shadow_rays"})
         if (options.has(key))
             throw std::invalid_argument(std::string("neepp=auto chooses light_sampler, within_light and shadow_rays itself: "
@@ -144,14 +146,16 @@ std::unique_ptr<Integrator> make_auto_path(const Options &options) {
     std::set<std::string> read;
     for (const AutoCandidate &c : auto_candidates()) {
         Options o = candidate_options(c);
-        make_path(o);
+        make_path(o, volumetric);
         const std::vector<std::string> unused = o.unused();
         for (const auto &[k, v] : values)
             if (std::find(unused.begin(), unused.end(), k) == unused.end()) read.insert(k);
     }
     for (const std::string &k : read) options.get_string(k, "");  // read by some candidate: not unused
     return std::make_unique<AutoIntegrator>(auto_candidates(),
-                                            [candidate_options](const AutoCandidate &c) { return make_path(candidate_options(c)); });
+                                            [candidate_options, volumetric](const AutoCandidate &c) {
+                                                return make_path(candidate_options(c), volumetric);
+                                            });
 }
 
 
@@ -170,7 +174,7 @@ const IntegratorPlugin *find_registered(const std::string &name) {
 }  // namespace
 
 void register_integrator(const std::string &name, IntegratorPlugin make) {
-    for (const char *own : {"path", "bdpt", "light", "pssmlt"})
+    for (const char *own : {"path", "volpath", "bdpt", "light", "pssmlt"})
         if (name == own) throw std::invalid_argument("register_integrator: '" + name + "' is one of neepp's own");
     if (name.empty()) throw std::invalid_argument("register_integrator: an integrator needs a name");
     std::lock_guard<std::mutex> lock(registry_mutex);
@@ -181,10 +185,11 @@ bool integrator_registered(const std::string &name) { return find_registered(nam
 
 std::unique_ptr<Integrator> make_integrator(const std::string &name, const Options &options) {
     std::unique_ptr<Integrator> integrator;
-    if (name == "path") {
+    if (name == "path" || name == "volpath") {
+        const bool volumetric = name == "volpath";
         const std::string mode = options.get_string("neepp", "off");
         if (mode != "off" && mode != "auto") throw std::invalid_argument("neepp must be 'off' or 'auto', not '" + mode + "'");
-        integrator = mode == "auto" ? make_auto_path(options) : make_path(options);
+        integrator = mode == "auto" ? make_auto_path(options, volumetric) : make_path(options, volumetric);
     } else if (name == "bdpt" || name == "light") {
         integrator = make_bdpt(name == "light", options);
     } else if (name == "pssmlt") {
@@ -217,7 +222,7 @@ std::unique_ptr<Integrator> make_integrator(const std::string &name, const Optio
         integrator = (*make)(options);
         if (!integrator) throw std::invalid_argument("the registered integrator '" + name + "' made nothing");
     } else {
-        throw std::invalid_argument("unknown integrator '" + name + "' (supported: path, bdpt, light, pssmlt)");
+        throw std::invalid_argument("unknown integrator '" + name + "' (supported: path, volpath, bdpt, light, pssmlt)");
     }
     if (auto unused = options.unused(); !unused.empty()) {
         std::string list;

@@ -75,6 +75,14 @@ std::vector<IntegratorDoc> make_docs() {
     }
     docs.push_back(path);
 
+    IntegratorDoc volpath = path;
+    volpath.name = "volpath";
+    volpath.description = "volumetric path tracing through participating media (Mitsuba 3's volpath): null surfaces "
+                          "crossed without a bounce, shadow rays through media and null surfaces; the reference form "
+                          "only";
+    std::erase_if(volpath.options, [](const OptionDoc &o) { return o.name == "form" || o.name.rfind("ris", 0) == 0; });
+    docs.push_back(volpath);
+
     IntegratorDoc bdpt{"bdpt", "bidirectional path tracing, every (s, t) strategy, MIS-weighted", common(b.max_depth, b.rr_depth, b.hide_emitters)};
     bdpt.options.push_back({"mis", "power", "MIS heuristic: power or balance", ""});
     bdpt.options.push_back({"strategy", "", "render only strategy S,T (s light and t camera vertices)", ""});

@@ -11,6 +11,7 @@
 #include "neepp/math/warp.h"
 #include "neepp/sampling/sampler.h"
 #include "neepp/scene/scene.h"
+#include <fmt/core.h>
 
 namespace neepp {
 
@@ -19,9 +20,15 @@ PathIntegrator::PathIntegrator(PathOptions options, std::unique_ptr<ShadowRayTes
 
 PathIntegrator::~PathIntegrator() = default;
 
-const RayBatch *PathIntegrator::batch() const { return options_.reference ? nullptr : batch_.get(); }
+const RayBatch *PathIntegrator::batch() const {
+    return options_.reference || options_.volumetric ? nullptr : batch_.get();
+}
 
 void PathIntegrator::prepare(const Scene &scene) {
+    // As Mitsuba's path: media are volpath's; path renders the scene as if in vacuum.
+    if (scene.has_media() && !options_.volumetric)
+        fmt::print(stderr, "neepp: note: the path integrator ignores the scene's participating media (as Mitsuba 3's "
+                           "path does); --integrator volpath renders them\n");
     // The factory keeps a map for a sampler that may read one; on a scene where it does not (one light),
     // a map that no shadow-ray policy uses either is not built. Resampling reads it on any scene.
     if (shadow_->policy() == "nee" && shadow_->visibility_map() &&
@@ -71,7 +78,7 @@ nlohmann::json PathIntegrator::statistics() const {
 }
 
 nlohmann::json PathIntegrator::describe() const {
-    return {{"name", "path"},
+    return {{"name", options_.volumetric ? "volpath" : "path"},
             {"max_depth", options_.max_depth},
             {"rr_depth", options_.rr_depth},
             {"hide_emitters", options_.hide_emitters},
@@ -164,6 +171,7 @@ Color PathIntegrator::sample_direct(const Scene &scene, const SurfaceInteraction
 }
 
 Color PathIntegrator::Li(const Scene &scene, const Ray &camera_ray, Sampler &sampler, RenderCounters &counters) const {
+    if (options_.volumetric) return Li_volumetric(scene, camera_ray, sampler, counters);
     Color L(0.f), beta(1.f);  // radiance so far, and the path throughput f·cos/pdf up to the current vertex
     float eta = 1.f;          // product of relative IORs crossed, for Russian roulette
     Ray ray = camera_ray;

@@ -32,6 +32,10 @@ struct PathOptions {
     // Which form renders: fast (PathBatch, the default) or reference (PathIntegrator::Li, one path at a
     // time: the definition, slower).
     bool reference = false;
+    // Mitsuba 3's volpath (volpath.cpp): paths through participating media, surfaces that are null to the
+    // path (null, a mask's clear part, a thin dielectric's transmission) crossed without counting a bounce,
+    // and shadow rays that pass such surfaces and media with their transmittance. Reference form only.
+    bool volumetric = false;
 };
 
 class PathBatch;
@@ -86,6 +90,11 @@ private:
         return options_.ris_depth < 0 || depth < options_.ris_depth ? options_.ris : 1;
     }
     bool resampling() const { return options_.ris > 1; }
+    // The volumetric form (volpath.cpp): Li when options_.volumetric.
+    struct ScatteringPoint;
+    Color Li_volumetric(const Scene &scene, const Ray &ray, Sampler &sampler, RenderCounters &counters) const;
+    Color sample_direct_volumetric(const Scene &scene, const ScatteringPoint &v, const Color &beta, int channel,
+                                   Sampler &sampler, RenderCounters &counters) const;
     // The map's share of the resampling target, from the map the coming pass reads.
     void refresh_resampling();
 

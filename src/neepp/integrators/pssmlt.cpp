@@ -50,6 +50,9 @@ PSSMLTIntegrator::PSSMLTIntegrator(PSSMLTOptions options, std::unique_ptr<Integr
 }
 
 void PSSMLTIntegrator::prepare(const Scene &scene) {
+    if (scene.has_media())
+        throw std::invalid_argument("pssmlt: participating media are not supported by its chains yet; render this "
+                                    "scene with the volpath integrator");
     inner_->prepare(scene);
     chains_.clear();
     bootstrapped_ = map_changed_ = false;

@@ -26,6 +26,9 @@ public:
     // nothing (its shapes are built for the instances); an `instance` adds placed copies of its group's.
     void shape(const XmlNode &node, Scene &scene);
     void emitter(const XmlNode &node, Scene &scene);
+    // A <medium> (made once however many shapes name it); the scene holds it after give_media_to.
+    const Medium *medium(const XmlNode &node);
+    void give_media_to(Scene &scene) const;
 
 private:
     // The shape in world space with its BSDF; emitter_node is set to its <emitter>, null when none.
@@ -46,6 +49,7 @@ private:
     std::map<const XmlNode *, int> bsdf_cost_;
     std::map<const XmlNode *, std::vector<std::unique_ptr<Shape>>> shape_groups_;
     BSDFPtr default_bsdf_, black_bsdf_;
+    std::map<const XmlNode *, std::shared_ptr<const Medium>> media_;
 };
 
 // f(), with any error it throws that does not say where (a plugin's, a constructor's) located at node.

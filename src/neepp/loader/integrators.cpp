@@ -26,8 +26,8 @@ struct Mapping {
     std::set<std::string> noise_only;  // options that change only the noise (sample counts): dropped
 };
 
-// Mitsuba 3's integrators and their equivalent here. Without participating media (which neepp refuses
-// where a scene declares them) volpath and volpathmis trace what path does; prb and prb_basic are path
+// Mitsuba 3's integrators and their equivalent here. volpathmis estimates what volpath does (it weighs
+// the channels' and the strategies' densities together, which changes the noise only); prb and prb_basic are path
 // tracers written for differentiation (prb_projective too); direct (and direct_projective, "prb_projective
 // with max_depth 2" in Mitsuba's docs) is next event estimation and BSDF sampling at the first hit only,
 // which path with max_depth 2 is; ptracer is particle tracing, neepp's light.
@@ -35,8 +35,7 @@ const std::map<std::string, Mapping> &mitsuba_integrators() {
     static const std::map<std::string, Mapping> m = {
         {"prb", {"path", -2, {}}},
         {"prb_basic", {"path", -2, {}}},
-        {"volpath", {"path", -2, {}}},
-        {"volpathmis", {"path", -2, {}}},
+        {"volpathmis", {"volpath", -2, {}}},
         {"direct", {"path", 2, {"emitter_samples", "bsdf_samples", "shading_samples"}}},
         {"ptracer", {"light", -2, {"samples_per_pass"}}},
         // The projective-sampling integrators differ from prb and direct in their derivatives only; their

@@ -109,7 +109,7 @@ void load_thin_lens(const XmlNode &sensor, Camera &cam) {
         loader::warn(sensor.file, sensor.line, "thinlens: aperture_radius 0 renders as a pinhole camera");
 }
 
-void load_sensor(const XmlNode &sensor, Scene &scene) {
+void load_sensor(const XmlNode &sensor, Scene &scene, loader::Factories &factories) {
     if (sensor.type != "perspective" && sensor.type != "thinlens" && sensor.type != "orthographic")
         throw sensor.error("unsupported sensor '" + sensor.type + "' (supported: " + supported_list("sensor") + ")");
     Camera &cam = scene.camera;
@@ -128,6 +128,9 @@ void load_sensor(const XmlNode &sensor, Scene &scene) {
             load_film(*child, scene);
         } else if (child->tag == "sampler") {
             load_sampler(*child, scene.settings);
+        } else if (child->tag == "medium") {  // the medium the camera sits in
+            if (cam.medium) throw child->error("a sensor sits in one medium (this is its second)");
+            cam.medium = factories.medium(*child);
         } else {
             throw child->error("unexpected <" + child->tag + "> inside the sensor");
         }
@@ -170,7 +173,7 @@ std::unique_ptr<Scene> read_scene(const std::string &path, const std::map<std::s
             factories.emitter(*node, *scene);
         } else if (tag == "sensor") {
             if (have_sensor) throw node->error("only one sensor is supported");
-            load_sensor(*node, *scene);
+            load_sensor(*node, *scene, factories);
             have_sensor = true;
         } else if (tag == "sampler") {
             // Mitsuba makes it and leaves it to the <ref>s that use it (a sensor's): alone it changes nothing,
@@ -184,11 +187,12 @@ std::unique_ptr<Scene> read_scene(const std::string &path, const std::map<std::s
             // no shape uses is checked too).
             if (loader::checking()) tag == "bsdf" ? (void)factories.bsdf(*node) : (void)factories.texture(*node);
         } else if (tag == "medium") {
-            throw node->error("participating media are not supported yet (<medium type=\"" + node->type + "\">)");
+            factories.medium(*node);  // declared for the shapes and the sensor that <ref> it
         } else {
             throw node->error("unsupported element <" + tag + "> at the top level of the scene");
         }
     });
+    factories.give_media_to(*scene);
     if (!have_sensor) {
         scene->camera.finalize();  // Mitsuba's default sensor would look from the origin; warn instead of guessing
         loader::warn(path, 0, "no <sensor>; using a default camera at the origin");

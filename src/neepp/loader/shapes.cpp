@@ -324,17 +324,26 @@ std::unique_ptr<Shape> Factories::build_shape(const XmlNode &node, const XmlNode
     s->flip_normals = flip_normals;
 
     emitter_node = nullptr;
-    for (const auto &child : node.children) {
+    for (size_t i = 0; i < node.children.size(); ++i) {
+        const auto &child = node.children[i];
         attempt([&] {  // when checking, a broken BSDF leaves the shape the default one
             if (child->tag == "bsdf") {
                 s->bsdf = bsdf(*child);
                 check_mesh_attributes(*child, *s, node);
+            } else if (child->tag == "emitter") {
+                emitter_node = child.get();
+            } else if (child->tag == "medium") {
+                // Named where it is nested or <ref>'d: the shape bounds it from inside or from outside.
+                const std::string &name = node.child_names[i];
+                if (name != "interior" && name != "exterior")
+                    throw child->error("a shape's medium is its \"interior\" or its \"exterior\" (name it so), not \"" +
+                                       name + "\"");
+                const Medium *&slot = name == "interior" ? s->interior : s->exterior;
+                if (slot) throw child->error("the shape has two " + name + " media");
+                slot = medium(*child);
+            } else {
+                throw child->error("unsupported inside a shape: <" + child->tag + ">");
             }
-            else if (child->tag == "emitter") emitter_node = child.get();
-            else if (child->tag == "medium" || child->tag == "ref" && (child->name == "interior" || child->name == "exterior"))
-                throw child->error("participating media are not supported yet (the shape's " +
-                                   (child->tag == "medium" ? "<medium>" : child->name + " medium") + ")");
-            else throw child->error("unsupported inside a shape: <" + child->tag + ">");
         });
     }
     // Mitsuba's default: diffuse 0.5, black on an emitter (a light without a BSDF reflects nothing).

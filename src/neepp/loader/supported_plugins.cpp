@@ -15,6 +15,8 @@ const std::vector<std::pair<std::string, std::vector<std::string>>> &supported_p
         {"texture", {"bitmap", "checkerboard", "rawconstant", "mesh_attribute"}},
         {"emitter", {"area", "envmap", "constant", "point", "spot", "directional", "projector"}},
         {"sensor", {"perspective", "orthographic"}},
+        {"medium", {"homogeneous"}},
+        {"phase", {"isotropic", "hg"}},
         {"film", {"hdrfilm"}},
         {"rfilter", {"box", "tent", "gaussian"}},
         // Mitsuba's stratified and low-discrepancy samplers render with neepp's sobol: the same expected image.

@@ -6,6 +6,11 @@ namespace neepp {
 
 float BlendBSDF::weight(const SurfaceInteraction &si) const { return std::clamp(weight_->eval_1(si), 0.f, 1.f); }
 
+Color BlendBSDF::null_transmission(const SurfaceInteraction &si, const Vec3 &wi) const {
+    const float w = weight(si);
+    return first_->null_transmission(si, wi) * (1.f - w) + second_->null_transmission(si, wi) * w;
+}
+
 Color BlendBSDF::eval(const BSDFContext &ctx, const SurfaceInteraction &si, const Vec3 &wi, const Vec3 &wo) const {
     const float w = weight(si);
     return first_->eval(ctx, si, wi, wo) * (1.f - w) + second_->eval(ctx, si, wi, wo) * w;

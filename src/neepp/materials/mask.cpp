@@ -18,6 +18,11 @@ BSDFEval MaskBSDF::eval_pdf(const BSDFContext &ctx, const SurfaceInteraction &si
     return {e.f * a, e.pdf * a};
 }
 
+Color MaskBSDF::null_transmission(const SurfaceInteraction &si, const Vec3 &wi) const {
+    const float a = opacity(si);
+    return Color(1.f - a) + nested_->null_transmission(si, wi) * a;
+}
+
 BSDFSample MaskBSDF::sample(const BSDFContext &ctx, const SurfaceInteraction &si, const Vec3 &wi, float u1,
                             Vec2 u2) const {
     float a = opacity(si);

@@ -17,6 +17,9 @@ public:
         return pass_through(wi, 1.f, transmittance_ ? transmittance_->eval(si) * scale_ : Color(1.f));
     }
     uint32_t flags() const override { return BSDFNull; }
+    Color null_transmission(const SurfaceInteraction &si, const Vec3 &) const override {
+        return transmittance_ ? transmittance_->eval(si) * scale_ : Color(1.f);
+    }
     bool needs_tangents() const override { return false; }
     void prefetch(const SurfaceInteraction &si) const override { prefetch_textures(si, transmittance_); }
 

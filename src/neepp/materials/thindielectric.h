@@ -26,7 +26,7 @@ public:
     // Slab reflectance R' for light arriving from wi (Mitsuba's eval_null_transmission is 1 - R' times
     // specular_transmittance: what a shadow ray passing through the pane keeps).
     float reflectance(const Vec3 &wi) const;
-    Color null_transmission(const SurfaceInteraction &si, const Vec3 &wi) const;
+    Color null_transmission(const SurfaceInteraction &si, const Vec3 &wi) const override;
 
 private:
     float eta_;

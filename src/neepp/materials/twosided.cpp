@@ -20,6 +20,10 @@ BSDFEval TwoSidedBSDF::eval_pdf(const BSDFContext &ctx, const SurfaceInteraction
     return wi.z >= 0 ? front_->eval_pdf(ctx, si, wi, wo) : back_->eval_pdf(ctx, si, flip_z(wi), flip_z(wo));
 }
 
+Color TwoSidedBSDF::null_transmission(const SurfaceInteraction &si, const Vec3 &wi) const {
+    return wi.z >= 0 ? front_->null_transmission(si, wi) : back_->null_transmission(si, flip_z(wi));
+}
+
 BSDFSample TwoSidedBSDF::sample(const BSDFContext &ctx, const SurfaceInteraction &si, const Vec3 &wi, float u1,
                                 Vec2 u2) const {
     if (wi.z >= 0) return front_->sample(ctx, si, wi, u1, u2);

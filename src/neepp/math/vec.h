@@ -56,6 +56,7 @@ inline Vec3 normalize(const Vec3 &v) { return v / norm(v); }
 inline Vec3 vmin(const Vec3 &a, const Vec3 &b) { return {std::min(a.x, b.x), std::min(a.y, b.y), std::min(a.z, b.z)}; }
 inline Vec3 vmax(const Vec3 &a, const Vec3 &b) { return {std::max(a.x, b.x), std::max(a.y, b.y), std::max(a.z, b.z)}; }
 inline float max_component(const Vec3 &v) { return std::max(v.x, std::max(v.y, v.z)); }
+inline Vec3 vexp(const Vec3 &v) { return {std::exp(v.x), std::exp(v.y), std::exp(v.z)}; }
 inline bool is_finite(const Vec3 &v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
 inline Vec3 reflect(const Vec3 &v, const Vec3 &n) { return 2.f * dot(v, n) * n - v; }
 inline Vec3 lerp(float t, const Vec3 &a, const Vec3 &b) { return (1 - t) * a + t * b; }

@@ -10,6 +10,8 @@
 namespace neepp {
 
 // A point of the scene seen from the camera, for light paths (light tracing, BDPT's t = 1 strategies).
+class Medium;
+
 struct CameraConnection {
     Vec2 raster;         // where on the film it lands, in pixels ((0,0) top-left, as film samples)
     Vec3 d;              // unit direction from the reference point toward the camera
@@ -35,6 +37,8 @@ struct Camera {
     float fov = 39.3077f;          // perspective only: degrees, along fov_axis (the loader sets Mitsuba 3's default when a scene gives none)
     std::string fov_axis = "x";    // x, y, diagonal, smaller, larger
     float near_clip = 1e-2f, far_clip = 1e4f;
+    // The medium the camera sits in (Mitsuba's sensor <medium>), where camera paths start; null: vacuum.
+    const Medium *medium = nullptr;
     // Perspective only: a thin lens (Mitsuba's `thinlens`) of this radius at the camera's position, in
     // focus at focus_distance along the view axis. 0: a pinhole. A camera ray then starts on the lens
     // disk and passes through the point of the focal plane its film position sees through the centre.

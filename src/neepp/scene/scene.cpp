@@ -157,6 +157,13 @@ Scene::~Scene() {
 
 void Scene::add_shape(std::unique_ptr<Shape> shape) { shapes_.push_back(std::move(shape)); }
 
+const Medium *Scene::add_medium(std::shared_ptr<const Medium> medium) {
+    for (const auto &m : media_)
+        if (m == medium) return m.get();
+    media_.push_back(std::move(medium));
+    return media_.back().get();
+}
+
 const Light *Scene::add_light(LightPtr light) {
     light->index = uint32_t(lights_.size());
     lights_.push_back(std::move(light));

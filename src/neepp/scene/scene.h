@@ -6,6 +6,7 @@
 #include <vector>
 #include <embree3/rtcore.h>
 #include "neepp/base/light.h"
+#include "neepp/base/medium.h"
 #include "neepp/scene/camera.h"
 #include "neepp/base/shape.h"
 #include "neepp/shapes/hit_lanes.h"
@@ -80,6 +81,9 @@ public:
     int packet_width() const { return packet_width_; }
     void set_packet_width(int width);
 
+    // Keeps a medium that shapes and the camera point to.
+    const Medium *add_medium(std::shared_ptr<const Medium> medium);
+    bool has_media() const { return !media_.empty(); }
     const std::vector<std::unique_ptr<Shape>> &shapes() const { return shapes_; }
     const std::vector<LightPtr> &lights() const { return lights_; }
     std::vector<const Light *> light_pointers() const;
@@ -100,6 +104,7 @@ private:
     // prefetched, filled in lanes and filled without a virtual call.
     std::vector<const TriangleMesh *> meshes_;
     std::vector<LightPtr> lights_;
+    std::vector<std::shared_ptr<const Medium>> media_;
     std::vector<const Light *> infinite_lights_;
     BBox bounds_;
 };

@@ -1,0 +1,57 @@
+// Participating media and phase functions, as Mitsuba 3 defines them: a medium gives its extinction and
+// scattering coefficients at a point and a majorant that bounds the extinction, with which free-flight
+// distances are sampled (delta tracking) and transmittance estimated (ratio tracking); a phase function
+// says how light scatters at a point of it. Media fill the insides and outsides of shapes that declare
+// them (Shape::interior, Shape::exterior) and the space around a camera that sits in one.
+#pragma once
+#include <memory>
+#include "neepp/math/bbox.h"
+#include "neepp/math/vec.h"
+
+namespace neepp {
+
+struct Ray;
+
+// Directions in world space. wi points back along the path (the negated direction of the ray that
+// arrived), wo where the light goes next, as at a surface.
+struct PhaseSample {
+    Vec3 wo;
+    float pdf = 0;     // solid-angle density of wo
+    float weight = 0;  // value / pdf
+};
+
+class PhaseFunction {
+public:
+    virtual ~PhaseFunction() = default;
+    // The phase function's value for light arriving along -wi and leaving along wo (it integrates to 1
+    // over wo), and the density with which sample() draws wo.
+    virtual float eval(const Vec3 &wi, const Vec3 &wo) const = 0;
+    virtual float pdf(const Vec3 &wi, const Vec3 &wo) const = 0;
+    virtual PhaseSample sample(const Vec3 &wi, Vec2 u) const = 0;
+};
+
+// The coefficients at a point: extinction sigma_t = absorption + scattering sigma_s (per unit length).
+struct MediumCoefficients {
+    Color sigma_t{0.f}, sigma_s{0.f};
+};
+
+class Medium {
+public:
+    virtual ~Medium() = default;
+    // The part [t0, t1] of the ray (within its tmin, tmax) where the medium may hold anything: the whole
+    // ray for a homogeneous medium, the box of its density grid for a heterogeneous one. False when none.
+    virtual bool overlap(const Ray &ray, float &t0, float &t1) const = 0;
+    // A bound on sigma_t everywhere in that part, per channel: free flights are drawn against it and the
+    // difference is filled with null collisions (sigma_n = majorant - sigma_t).
+    virtual Color majorant() const = 0;
+    virtual MediumCoefficients at(const Vec3 &p) const = 0;
+    // Whether sigma_t is the same everywhere (then it is the majorant, and there are no null collisions).
+    virtual bool homogeneous() const = 0;
+
+    std::shared_ptr<const PhaseFunction> phase;
+    // Mitsuba's sample_emitters: whether scattering points in it sample lights (false: only light that a
+    // phase-sampled path finds, as in the subsurface scenes whose lights lie outside a dielectric).
+    bool sample_emitters = true;
+};
+
+}  // namespace neepp

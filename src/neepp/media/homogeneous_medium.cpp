@@ -1,0 +1,17 @@
+#include "neepp/media/homogeneous_medium.h"
+
+#include "neepp/base/interaction.h"
+
+namespace neepp {
+
+HomogeneousMedium::HomogeneousMedium(Color sigma_t, Color albedo) {
+    coefficients_.sigma_t = sigma_t;
+    coefficients_.sigma_s = sigma_t * albedo;
+}
+
+bool HomogeneousMedium::overlap(const Ray &ray, float &t0, float &t1) const {
+    t0 = ray.tmin, t1 = ray.tmax;
+    return t1 > t0;
+}
+
+}  // namespace neepp

@@ -1,0 +1,114 @@
+// The volumetric path tracer against analytic answers: an absorbing slab's transmittance per channel, the
+// single scattering of a slab lit from above (which fixes how max_depth counts collisions and null
+// crossings, and Henyey-Greenstein's sign), and a medium furnace (an albedo-1 medium in a uniform sky
+// looks like the sky), through every shadow-ray policy and light choice, NEE on and off.
+#include <gtest/gtest.h>
+#include <cmath>
+#include <fmt/core.h>
+#include "test_scenes.h"
+
+using namespace neepp;
+using namespace neepp::testing;
+
+namespace {
+
+// An orthographic camera at z = 5 looking down -z over [-1, 1]^2, a slab z in [-h/2, h/2] of null faces
+// around the medium (`medium` is its XML body), and `lights`.
+std::string slab_xml(float h, const std::string &medium, const std::string &lights, int max_depth) {
+    return fmt::format(R"(<scene version="3.0.0">
+  <integrator type="volpath"><integer name="max_depth" value="{max_depth}"/></integrator>
+  <sensor type="orthographic"><transform name="to_world"><lookat origin="0,0,5" target="0,0,0" up="0,1,0"/></transform>
+    <film type="hdrfilm"><integer name="width" value="16"/><integer name="height" value="16"/><rfilter type="box"/></film></sensor>
+  {lights}
+  <shape type="cube"><transform name="to_world"><scale x="50" y="50" z="{half}"/></transform>
+    <bsdf type="null"/><medium type="homogeneous" name="interior">{medium}</medium></shape>
+</scene>)",
+                       fmt::arg("max_depth", max_depth), fmt::arg("half", h / 2), fmt::arg("medium", medium),
+                       fmt::arg("lights", lights));
+}
+
+// |image mean - expected| per channel within 5 standard errors (plus a little for float rounding).
+void expect_mean(const Image &img, const Color &expected, const std::string &what) {
+    for (int c = 0; c < 3; ++c) {
+        const MeanStderr st = pixel_statistics(img, c);
+        EXPECT_NEAR(st.mean, expected[c], 5 * st.stderr_ + 2e-4 * expected[c] + 1e-6) << what << " channel " << c;
+    }
+}
+
+}  // namespace
+
+TEST(VolPath, AbsorbingSlabTransmitsExactlyPerChannel) {
+    const float h = 0.8f;
+    const Color sigma_t(0.5f, 1.5f, 2.f);
+    const std::string path = write_temp_scene(slab_xml(
+        h, R"(<rgb name="sigma_t" value="0.25, 0.75, 1"/><float name="scale" value="2"/><float name="albedo" value="0"/>)",
+        R"(<emitter type="constant"><rgb name="radiance" value="1"/></emitter>)", -1));
+    // 1: the sky is seen through the slab's null faces, which are no bounce.
+    for (int max_depth : {-1, 1}) {
+        Options o;
+        o.set("max_depth", std::to_string(max_depth));
+        const auto out = render_scene_file(path, 512, 3, o, "volpath");
+        expect_mean(out.image, vexp(-sigma_t * h), "max_depth " + std::to_string(max_depth));
+    }
+}
+
+// Light travelling down -z onto the slab, seen from above: with max_depth 2 only light scattered once,
+// back toward the camera, arrives: L = sigma_s p(backward) E (1 - e^{-2 sigma_t h}) / (2 sigma_t).
+TEST(VolPath, SingleScatteringOfALitSlab) {
+    const float h = 0.6f, g = 0.4f, E = 3.f;
+    const Color sigma_t(0.8f, 2.f, 4.f), albedo(0.9f, 0.5f, 0.7f);
+    const std::string medium = fmt::format(
+        R"(<rgb name="sigma_t" value="0.2, 0.5, 1"/><float name="scale" value="4"/><rgb name="albedo" value="0.9, 0.5, 0.7"/>
+           <phase type="hg"><float name="g" value="{}"/></phase>)", g);
+    const std::string light = fmt::format(
+        R"(<emitter type="directional"><vector name="direction" value="0,0,-1"/><rgb name="irradiance" value="{}"/></emitter>)", E);
+    const std::string path = write_temp_scene(slab_xml(h, medium, light, 2));
+    const float backward = (1 - g * g) / (4 * kPi * std::pow(1 + g, 3.f));
+    Color expected;
+    for (int c = 0; c < 3; ++c)
+        expected[c] = albedo[c] * sigma_t[c] * backward * E * (1 - std::exp(-2 * sigma_t[c] * h)) / (2 * sigma_t[c]);
+    const auto out = render_scene_file(path, 512, 5, Options(), "volpath");
+    expect_mean(out.image, expected, "single scattering");
+    // A collision is a bounce: with max_depth 1 nothing scattered arrives.
+    Options one;
+    one.set("max_depth", "1");
+    const auto none = render_scene_file(path, 64, 5, one, "volpath");
+    expect_mean(none.image, Color(0.f), "max_depth 1");
+}
+
+// An albedo-1 medium neither adds nor removes light: in a uniform sky every pixel is the sky, whatever
+// the estimator (NEE or not, every shadow-ray policy, a light choice that reads the map).
+TEST(VolPath, MediumFurnaceIsTheSky) {
+    const std::string path = write_temp_scene(R"(<scene version="3.0.0">
+  <integrator type="volpath"/>
+  <sensor type="perspective"><float name="fov" value="40"/>
+    <transform name="to_world"><lookat origin="0,0,4" target="0,0,0" up="0,1,0"/></transform>
+    <film type="hdrfilm"><integer name="width" value="12"/><integer name="height" value="12"/><rfilter type="box"/></film></sensor>
+  <emitter type="constant"><rgb name="radiance" value="1"/></emitter>
+  <shape type="sphere"><float name="radius" value="1.2"/><bsdf type="null"/>
+    <medium type="homogeneous" name="interior"><rgb name="sigma_t" value="0.5, 1, 0.25"/><float name="scale" value="3"/>
+      <float name="albedo" value="1"/><phase type="hg"><float name="g" value="0.5"/></phase></medium></shape>
+</scene>)");
+    const std::vector<std::map<std::string, std::string>> variants = {
+        {}, {{"nee", "false"}}, {{"shadow_rays", "neepp"}}, {{"shadow_rays", "neepp-adaptive"}},
+        {{"shadow_rays", "neepp-cv"}}, {{"light_sampler", "visibility"}}};
+    for (const auto &v : variants) {
+        std::string what;
+        for (const auto &[k, val] : v) what += k + "=" + val + " ";
+        const auto out = render_scene_file(path, 256, 11, Options(v), "volpath");
+        expect_mean(out.image, Color(1.f), what);
+    }
+}
+
+TEST(VolPath, LightPathsAndChainsRefuseMediaNamingVolpath) {
+    const std::string path = write_temp_scene(slab_xml(
+        0.5f, R"(<float name="albedo" value="0.5"/>)", R"(<emitter type="constant"><rgb name="radiance" value="1"/></emitter>)", -1));
+    for (const char *name : {"bdpt", "light", "pssmlt"}) {
+        try {
+            render_scene_file(path, 1, 1, Options(), name);
+            ADD_FAILURE() << name << " rendered a scene with media";
+        } catch (const std::exception &e) {
+            EXPECT_NE(std::string(e.what()).find("volpath"), std::string::npos) << e.what();
+        }
+    }
+}
