@@ -5,6 +5,9 @@
 #include <gtest/gtest.h>
 #include <cmath>
 #include <fmt/core.h>
+#include <filesystem>
+#include <fstream>
+#include "common/volume_grid_writer.h"
 #include "test_scenes.h"
 
 using namespace neepp;
@@ -50,6 +53,45 @@ TEST(VolPath, AbsorbingSlabTransmitsExactlyPerChannel) {
         const auto out = render_scene_file(path, 512, 3, o, "volpath");
         expect_mean(out.image, vexp(-sigma_t * h), "max_depth " + std::to_string(max_depth));
     }
+}
+
+// A heterogeneous medium: its density varies along z only (a grid of 2 x 2 x 8 texels stretched over the
+// slab), so every ray down through it sees exp(-scale ∫ sigma_t dz), which the trilinear interpolant gives
+// exactly: each texel's value over its own height, the half texels at the faces at the face texel's value.
+// The camera's rays sample it by delta tracking with null collisions (albedo 0: a real one ends the path).
+// And a heterogeneous medium with one constant value renders the homogeneous slab's transmittance.
+TEST(VolPath, HeterogeneousSlabTransmitsItsIntegral) {
+    const float h = 0.8f, scale = 1.5f;
+    const float column[8] = {0.2f, 1.f, 0.5f, 2.f, 0.f, 1.5f, 0.7f, 0.3f};
+    VolumeGridFile g;
+    g.size[0] = 2, g.size[1] = 2, g.size[2] = 8, g.channels = 3;
+    for (int z = 0; z < 8; ++z)
+        for (int k = 0; k < 4; ++k)
+            for (int c = 0; c < 3; ++c) g.values.push_back(column[z] * (c == 0 ? 1.f : c == 1 ? 0.5f : 2.f));
+    const std::string dir = std::filesystem::path(write_temp_scene("", "density.vol")).parent_path().string();
+    {
+        std::ofstream(dir + "/density.vol", std::ios::binary) << volume_grid_bytes(g);
+    }
+    double integral = 0;  // of the interpolant over [0, 1] in z: half texels at each face, lines between centres
+    for (int z = 0; z < 8; ++z) integral += column[z] / 8.0;
+    const std::string medium = fmt::format(
+        R"(<volume name="sigma_t" type="gridvolume"><string name="filename" value="{dir}/density.vol"/>
+             <transform name="to_world"><scale x="200" y="200" z="{h}"/><translate x="-100" y="-100" z="{lo}"/></transform></volume>
+           <float name="scale" value="{scale}"/><float name="albedo" value="0"/>)",
+        fmt::arg("dir", dir), fmt::arg("h", h), fmt::arg("lo", -h / 2), fmt::arg("scale", scale));
+    std::string xml = slab_xml(h, medium, R"(<emitter type="constant"><rgb name="radiance" value="1"/></emitter>)", -1);
+    const std::string homogeneous = R"(type="homogeneous")", heterogeneous = R"(type="heterogeneous")";
+    xml.replace(xml.find(homogeneous), homogeneous.size(), heterogeneous);
+    const auto out = render_scene_file(write_temp_scene(xml), 1024, 3, Options(), "volpath");
+    const double tau = scale * integral * h;
+    expect_mean(out.image, Color(float(std::exp(-tau)), float(std::exp(-0.5 * tau)), float(std::exp(-2 * tau))), "grid");
+
+    std::string flat = slab_xml(h, R"(<volume name="sigma_t" type="constvolume"><rgb name="value" value="0.25, 0.75, 1"/></volume>
+                                      <float name="scale" value="2"/><float name="albedo" value="0"/>)",
+                                R"(<emitter type="constant"><rgb name="radiance" value="1"/></emitter>)", -1);
+    flat.replace(flat.find(homogeneous), homogeneous.size(), heterogeneous);
+    const auto out_flat = render_scene_file(write_temp_scene(flat), 1024, 3, Options(), "volpath");
+    expect_mean(out_flat.image, vexp(-Color(0.5f, 1.5f, 2.f) * h), "constant");
 }
 
 // Light travelling down -z onto the slab, seen from above: with max_depth 2 only light scattered once,

@@ -62,6 +62,9 @@ const TempDir &aux_files() {
         dir.write("line.txt", "-1 0 0 0.25\n1 0 0 0.25\n");
         dir.write("spline.txt", "-1 0 0 0.25\n-0.5 0 0 0.25\n0.5 0 0 0.25\n1 0 0 0.25\n");
         dir.write("grid.vol", volume_grid_bytes(sphere_sdf_grid(4)));
+        VolumeGridFile density;
+        density.values.assign(8, 0.5f);
+        dir.write("density.vol", volume_grid_bytes(density));
         Image img(2, 2, 3);
         std::fill(img.data.begin(), img.data.end(), 0.5f);
         write_exr((dir.dir / "image.exr").string(), img);
@@ -201,7 +204,15 @@ std::map<std::string, std::map<std::string, PluginCase>> plugin_cases() {
         {"medium",
          {{"homogeneous", {R"(<shape type="sphere"><bsdf type="null"/><medium type="homogeneous" name="interior">@</medium></shape>)",
                            {refused("sigma_t", "rgb"), refused("sigma_t", "float"), refused("albedo", "rgb"),
-                            refused("albedo", "spectrum"), refused("scale", "float")}}}}},
+                            refused("albedo", "spectrum"), refused("scale", "float")}}},
+          {"heterogeneous", {R"(<shape type="sphere"><bsdf type="null"/><medium type="heterogeneous" name="interior">@</medium></shape>)",
+                             {refused("sigma_t", "float"), refused("albedo", "rgb"), refused("scale", "float")}}}}},
+        {"volume",
+         {{"constvolume", {R"(<shape type="sphere"><bsdf type="null"/><medium type="heterogeneous" name="interior"><volume name="sigma_t" type="constvolume">@</volume></medium></shape>)",
+                           {refused("value", "rgb"), refused("value", "float")}}},
+          {"gridvolume", {R"(<shape type="sphere"><bsdf type="null"/><medium type="heterogeneous" name="interior"><volume name="sigma_t" type="gridvolume"><string name="filename" value=")" +
+                              aux("density.vol") + R"("/>@</volume></medium></shape>)",
+                          {refused("max_value", "float"), accepted("to_world", "transform")}}}}},
         {"phase",
          {{"isotropic", {R"(<shape type="sphere"><bsdf type="null"/><medium type="homogeneous" name="interior"><phase type="isotropic">@</phase></medium></shape>)",
                          {}}},

@@ -8,6 +8,7 @@
 #include "neepp/materials/hair.h"
 #include "neepp/materials/principled.h"
 #include "neepp/materials/principledthin.h"
+#include "neepp/media/volume.h"
 #include "neepp/scene/scene.h"
 
 namespace neepp::loader {
@@ -28,6 +29,7 @@ public:
     void emitter(const XmlNode &node, Scene &scene);
     // A <medium> (made once however many shapes name it); the scene holds it after give_media_to.
     const Medium *medium(const XmlNode &node);
+    std::shared_ptr<const Volume> volume_param(const XmlNode &node, const std::string &name, Color def);
     void give_media_to(Scene &scene) const;
 
 private:

@@ -1,6 +1,8 @@
 // Mitsuba 3's participating media (<medium>) and phase functions (<phase>), and the scene's hold on them.
 #include "neepp/loader/factories.h"
 #include "neepp/loader/problems.h"
+#include "neepp/io/volume_grid_reader.h"
+#include "neepp/media/heterogeneous_medium.h"
 #include "neepp/media/homogeneous_medium.h"
 #include "neepp/media/phase_functions.h"
 
@@ -18,37 +20,88 @@ std::shared_ptr<const PhaseFunction> make_phase(const XmlNode &node) {
     throw node.error("unsupported phase function '" + node.type + "' (supported: isotropic, hg)");
 }
 
+// A <volume> (constvolume or gridvolume) as Mitsuba 3 reads it.
+std::shared_ptr<const Volume> make_volume(const XmlNode &node) {
+    if (node.type == "constvolume")
+        return std::make_shared<ConstantVolume>(node.get_unbounded_rgb("value", Color(1.f)));
+    if (node.type != "gridvolume" && node.type != "grid")
+        throw node.error("unsupported volume '" + node.type + "' (supported: constvolume, gridvolume)");
+    GridVolumeOptions o;
+    const std::string filter = node.get_string("filter_type", "trilinear");
+    if (filter != "trilinear" && filter != "nearest")
+        throw node.property_error("filter_type", "must be \"trilinear\" or \"nearest\"");
+    o.filter = filter == "nearest" ? GridVolumeOptions::Filter::Nearest : GridVolumeOptions::Filter::Trilinear;
+    const std::string wrap = node.get_string("wrap_mode", "clamp");
+    if (wrap != "clamp" && wrap != "repeat" && wrap != "mirror")
+        throw node.property_error("wrap_mode", "must be \"clamp\", \"repeat\" or \"mirror\"");
+    o.wrap = wrap == "repeat" ? GridVolumeOptions::Wrap::Repeat
+             : wrap == "mirror" ? GridVolumeOptions::Wrap::Mirror : GridVolumeOptions::Wrap::Clamp;
+    o.to_world = node.get_transform("to_world");
+    o.use_grid_bbox = node.get_bool("use_grid_bbox", false);
+    o.max_value = node.get_float("max_value", -1.f, NumberRange::above(0));  // -1: absent, the data's own
+    node.get_bool("raw", false);   // the data is used as stored either way in RGB
+    node.get_string("accel", "");  // Mitsuba's GPU texture option
+    if (!node.has("filename")) throw node.error("a gridvolume needs a 'filename': its grid as a .vol file");
+    const std::string path = node.resolve_path(node.get_string("filename"));
+    try {  // the file's own error, located at the volume using it
+        return std::make_shared<GridVolume>(read_volume_grid(path), o);
+    } catch (const std::exception &e) {
+        throw node.error(e.what());
+    }
+}
+
 }  // namespace
+
+// A medium's coefficient `name`: a nested <volume>, or a <float>, <rgb> or <spectrum> (a constant volume).
+std::shared_ptr<const Volume> Factories::volume_param(const XmlNode &node, const std::string &name, Color def) {
+    if (std::shared_ptr<XmlNode> child = node.child(name)) {
+        if (child->tag != "volume")
+            throw child->error("a medium's '" + name + "' is a <volume>, a <float>, an <rgb> or a <spectrum>, not a <" +
+                               child->tag + ">");
+        auto v = located_at(*child, [&] { return make_volume(*child); });
+        warn_unused(*child);
+        return v;
+    }
+    // As Mitsuba: an <rgb> coefficient lies in [0, 1] (scale sets the density), a <float> may be any
+    // non-negative value.
+    return std::make_shared<ConstantVolume>(node.get_rgb(name, def));
+}
 
 const Medium *Factories::medium(const XmlNode &node) {
     if (auto it = media_.find(&node); it != media_.end()) return it->second.get();
     if (node.tag != "medium") throw node.error("expected a <medium>, found <" + node.tag + ">");
-    if (node.type == "heterogeneous")
-        throw node.error("heterogeneous media (density grids) are not supported yet; homogeneous media are");
-    if (node.type != "homogeneous")
-        throw node.error("unsupported medium '" + node.type + "' (supported: homogeneous)");
+    if (node.type != "homogeneous" && node.type != "heterogeneous")
+        throw node.error("unsupported medium '" + node.type + "' (supported: homogeneous, heterogeneous)");
     std::shared_ptr<const PhaseFunction> phase;
-    for (const auto &child : node.children) {
+    for (size_t i = 0; i < node.children.size(); ++i) {
+        const auto &child = node.children[i];
         if (child->tag == "phase") {
             if (phase) throw child->error("a medium has one phase function (this is its second)");
             phase = located_at(*child, [&] { return make_phase(*child); });
             warn_unused(*child);
-        } else if (child->tag == "volume" || child->tag == "texture") {
-            throw child->error("a medium's coefficients given as a volume or texture are not supported yet; give "
-                               "sigma_t and albedo as <float>, <rgb> or <spectrum>");
+        } else if (child->tag == "volume") {
+            const std::string &name = node.child_names[i];
+            if (name != "sigma_t" && name != "albedo")
+                throw child->error("a medium's volumes are its \"sigma_t\" and \"albedo\", not \"" + name + "\"");
         } else {
             throw child->error("unsupported inside a medium: <" + child->tag + ">");
         }
     }
-    // As Mitsuba: an <rgb> coefficient lies in [0, 1] (scale sets the density), a <float> may be any
-    // non-negative value.
-    const Color sigma_t = node.get_rgb("sigma_t", Color(1.f));
-    const Color albedo = node.get_rgb("albedo", Color(0.75f));
+    const std::shared_ptr<const Volume> sigma_t = volume_param(node, "sigma_t", Color(1.f));
+    const std::shared_ptr<const Volume> albedo = volume_param(node, "albedo", Color(0.75f));
     const float scale = node.get_float("scale", 1.f, NumberRange::at_least(0));
     // Mitsuba's switch between two estimators of the same image; neepp always weighs each channel by its
     // own extinction (its spectral route), which is exact for grey media too.
     node.get_bool("has_spectral_extinction", true);
-    auto m = std::make_shared<HomogeneousMedium>(sigma_t * scale, albedo);
+    std::shared_ptr<Medium> m;
+    if (node.type == "homogeneous") {
+        if (!std::dynamic_pointer_cast<const ConstantVolume>(sigma_t))
+            throw node.error("a homogeneous medium's sigma_t is one value (a <float>, <rgb>, <spectrum> or constvolume); "
+                             "a grid of them makes a heterogeneous medium");
+        m = std::make_shared<HomogeneousMedium>(sigma_t->eval(Vec3(0.f)) * scale, albedo);
+    } else {
+        m = std::make_shared<HeterogeneousMedium>(sigma_t, albedo, scale);
+    }
     m->phase = phase ? phase : std::make_shared<IsotropicPhase>();
     m->sample_emitters = node.get_bool("sample_emitters", true);
     warn_unused(node);

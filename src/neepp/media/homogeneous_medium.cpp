@@ -4,10 +4,8 @@
 
 namespace neepp {
 
-HomogeneousMedium::HomogeneousMedium(Color sigma_t, Color albedo) {
-    coefficients_.sigma_t = sigma_t;
-    coefficients_.sigma_s = sigma_t * albedo;
-}
+HomogeneousMedium::HomogeneousMedium(Color sigma_t, std::shared_ptr<const Volume> albedo)
+    : sigma_t_(sigma_t), albedo_(std::move(albedo)) {}
 
 bool HomogeneousMedium::overlap(const Ray &ray, float &t0, float &t1) const {
     t0 = ray.tmin, t1 = ray.tmax;

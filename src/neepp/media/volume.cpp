@@ -1,0 +1,65 @@
+#include "neepp/media/volume.h"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+
+namespace neepp {
+
+GridVolume::GridVolume(VolumeGrid grid, const GridVolumeOptions &options) : grid_(std::move(grid)), options_(options) {
+    if (grid_.channels != 1 && grid_.channels != 3)
+        throw std::invalid_argument("a gridvolume has 1 or 3 channels, this grid " + std::to_string(grid_.channels));
+    for (float v : grid_.values)
+        if (!std::isfinite(v) || v < 0)
+            throw std::invalid_argument("the grid holds a value that is not a finite non-negative number (" +
+                                        std::to_string(v) + ")");
+    max_ = options.max_value > 0 ? options.max_value : *std::max_element(grid_.values.begin(), grid_.values.end());
+    // to_local maps world points to the unit cube: through to_world's inverse, then, with use_grid_bbox,
+    // from the file's bounds.
+    Transform to_world = options.to_world;
+    if (options.use_grid_bbox) {
+        const Vec3 lo = grid_.bounds.lo, extent = grid_.bounds.hi - grid_.bounds.lo;
+        if (!(extent.x > 0 && extent.y > 0 && extent.z > 0)) throw std::invalid_argument("use_grid_bbox: the grid's bounds are empty");
+        to_world = to_world * Transform::translate(lo) * Transform::scale(extent);
+    }
+    to_local_ = Transform(to_world.inverse_matrix, to_world.matrix);
+    for (int k = 0; k < 8; ++k) bounds_.expand(to_world.point(Vec3(float(k & 1), float(k >> 1 & 1), float(k >> 2 & 1))));
+}
+
+int64_t GridVolume::wrap(int64_t i, uint32_t n) const {
+    const int64_t m = int64_t(n);
+    switch (options_.wrap) {
+    case GridVolumeOptions::Wrap::Clamp: return std::clamp<int64_t>(i, 0, m - 1);
+    case GridVolumeOptions::Wrap::Repeat: return ((i % m) + m) % m;
+    case GridVolumeOptions::Wrap::Mirror: {
+        const int64_t period = ((i % (2 * m)) + 2 * m) % (2 * m);
+        return period < m ? period : 2 * m - 1 - period;
+    }
+    }
+    return 0;
+}
+
+Color GridVolume::texel(int64_t x, int64_t y, int64_t z) const {
+    const uint32_t ix = uint32_t(wrap(x, grid_.size[0])), iy = uint32_t(wrap(y, grid_.size[1])), iz = uint32_t(wrap(z, grid_.size[2]));
+    if (grid_.channels == 1) return Color(grid_.at(ix, iy, iz));
+    return Color(grid_.at(ix, iy, iz, 0), grid_.at(ix, iy, iz, 1), grid_.at(ix, iy, iz, 2));
+}
+
+Color GridVolume::eval(const Vec3 &p) const {
+    const Vec3 u = to_local_.point(p);
+    const float res[3] = {float(grid_.size[0]), float(grid_.size[1]), float(grid_.size[2])};
+    if (options_.filter == GridVolumeOptions::Filter::Nearest)
+        return texel(int64_t(std::floor(u.x * res[0])), int64_t(std::floor(u.y * res[1])), int64_t(std::floor(u.z * res[2])));
+    // Texel centres at (i + 0.5) / res, as Dr.Jit's lookups: the eight around u, weighted trilinearly.
+    const float gx = u.x * res[0] - 0.5f, gy = u.y * res[1] - 0.5f, gz = u.z * res[2] - 0.5f;
+    const float fx = std::floor(gx), fy = std::floor(gy), fz = std::floor(gz);
+    const float wx = gx - fx, wy = gy - fy, wz = gz - fz;
+    const int64_t x = int64_t(fx), y = int64_t(fy), z = int64_t(fz);
+    auto lerp3 = [](const Color &a, const Color &b, float t) { return a * (1.f - t) + b * t; };
+    const Color c00 = lerp3(texel(x, y, z), texel(x + 1, y, z), wx), c10 = lerp3(texel(x, y + 1, z), texel(x + 1, y + 1, z), wx);
+    const Color c01 = lerp3(texel(x, y, z + 1), texel(x + 1, y, z + 1), wx),
+                c11 = lerp3(texel(x, y + 1, z + 1), texel(x + 1, y + 1, z + 1), wx);
+    return lerp3(lerp3(c00, c10, wy), lerp3(c01, c11, wy), wz);
+}
+
+}  // namespace neepp
