@@ -60,6 +60,7 @@ struct BSDFEval {
 class BSDF {
 public:
     virtual ~BSDF() = default;
+    // --- What every BSDF defines.
     virtual Color eval(const BSDFContext &ctx, const SurfaceInteraction &si, const Vec3 &wi, const Vec3 &wo) const = 0;
     virtual float pdf(const BSDFContext &ctx, const SurfaceInteraction &si, const Vec3 &wi, const Vec3 &wo) const = 0;
     // eval and pdf at once: next event estimation needs both (the contribution and its MIS weight), and
@@ -72,13 +73,15 @@ public:
     virtual BSDFSample sample(const BSDFContext &ctx, const SurfaceInteraction &si, const Vec3 &wi, float u1,
                               Vec2 u2) const = 0;
     virtual uint32_t flags() const = 0;
+
+    // --- Optional, each with a default that is right for every BSDF.
     // What passes straight through the surface, not scattered, for light arriving from wi (Mitsuba's
     // eval_null_transmission): what a ray toward a light through a participating medium keeps where it
     // crosses the surface. 0 for a surface opaque to such rays, which most are; the null BSDF's
     // transmittance, a thin dielectric's 1 - R, a mask's 1 - opacity.
     virtual Color null_transmission(const SurfaceInteraction &si, const Vec3 &wi) const { return Color(0.f); }
-    // Cache prefetch of the texture data that evaluating or sampling at si (seen from si.wi) will read.
-    // A hint for batched integrators, issued well before shading; it never changes a result.
+    // Speed hook: cache prefetch of the texture data that evaluating or sampling at si (seen from si.wi)
+    // will read. A hint for batched integrators, issued well before shading; it never changes a result.
     virtual void prefetch(const SurfaceInteraction &si) const {}
     // Whether evaluating or sampling reads si.dpdu / si.dpdv or depends on which way the shading frame's
     // tangent points (bump maps, anisotropic roughness). A BSDF that does not may say false: its shapes'

@@ -25,9 +25,9 @@ class LightSampler {
 public:
     virtual ~LightSampler() = default;
     virtual SampledLight sample(const LightSampleContext &ctx, float u) const = 0;
-    // n lights for one shading point, out[i] what sample(ctx, u[i]) returns (to the bit): for resampled
-    // NEE's candidates. Samplers whose choice has work common to all samples (the light BVH's node
-    // importances) do it once.
+    // Speed hook, optional: n lights for one shading point, out[i] what sample(ctx, u[i]) returns (to the
+    // bit), for resampled NEE's candidates. Samplers whose choice has work common to all samples (the light
+    // BVH's node importances) do it once.
     virtual void sample_many(const LightSampleContext &ctx, const float *u, int n, SampledLight *out) const {
         for (int i = 0; i < n; ++i) out[i] = sample(ctx, u[i]);
     }

@@ -19,7 +19,7 @@ public:
     // Average value over the texture's domain (for light power estimates and plastic's sampling weights).
     virtual Color mean() const = 0;
     virtual bool is_constant() const { return false; }
-    // Cache prefetch of what eval(si) will read (see BSDF::prefetch).
+    // Speed hook, optional: cache prefetch of what eval(si) will read (see BSDF::prefetch).
     virtual void prefetch(const SurfaceInteraction &) const {}
 };
 
