@@ -319,7 +319,7 @@ TEST(SceneCheck, ListsEveryProblemAtOnce) {
         "  <bsdf type=\"glitter\"/>\n"                                                        // 7
         "</shape>\n"                                                                          // 8
         "<shape type=\"teapot\"/>\n"                                                          // 9
-        "<medium type=\"heterogeneous\" id=\"fog\"/>\n");                                     // 10
+        "<medium type=\"homogeneous\" id=\"fog\"><phase type=\"rayleigh\"/></medium>\n");    // 10
     const std::string path = write_temp_scene(xml, "many_problems.xml");
     const std::vector<SceneProblem> problems = check_scene(path);
     std::vector<std::pair<int, bool>> where;
@@ -332,7 +332,7 @@ TEST(SceneCheck, ListsEveryProblemAtOnce) {
     EXPECT_EQ(where, expected);
     EXPECT_NE(problems[1].problem.find("no-such-mesh.obj"), std::string::npos);
     EXPECT_NE(problems[3].problem.find("radiuss"), std::string::npos);
-    EXPECT_NE(problems[5].problem.find("heterogeneous media"), std::string::npos);
+    EXPECT_NE(problems[5].problem.find("unsupported phase function 'rayleigh'"), std::string::npos);
     EXPECT_NE(problems[6].problem.find("no light source"), std::string::npos);
     EXPECT_EQ(problems[0].text().rfind(path + ":3: error: ", 0), 0u) << problems[0].text();
     EXPECT_NE(load_error(xml, "many_problems.xml").find("many_problems.xml:4:"), std::string::npos);  // render: the first
