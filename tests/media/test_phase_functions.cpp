@@ -26,7 +26,10 @@ const Vec3 kWi = normalize(Vec3(0.3f, -0.5f, 0.8f));
 }  // namespace
 
 TEST(PhaseFunctions, SamplingMatchesPdf) {
-    for (const auto &[name, phase] : phases()) {
+    for (const auto &entry : phases()) {
+        // (clang 14 cannot capture a structured binding in the lambdas below)
+        const std::string &name = entry.first;
+        const PhaseFunction *phase = entry.second.get();
         SphereChi2Config cfg;
         cfg.sample_count = 400000;
         cfg.res = 100;
