@@ -486,6 +486,15 @@ TEST(SceneErrors, MediaMistakesNameTheirLine) {
     const std::string two = R"(<scene version="3.0.0"><sensor type="perspective"><medium type="homogeneous"/><medium type="homogeneous"/>
       <film type="hdrfilm"><integer name="width" value="8"/><integer name="height" value="8"/></film></sensor>)" + std::string(kLight) + "</scene>";
     EXPECT_NE(load_error(two).find("one medium"), std::string::npos);
+    // A medium that fills nothing loads, as in Mitsuba, with a warning at its line; the scene has no media.
+    const std::string idle = write_temp_scene(scene_with("<shape type=\"sphere\"/>\n<medium type=\"homogeneous\" id=\"idle\"/>\n" +
+                                                         std::string(kLight)), "idle.xml");
+    const std::vector<SceneProblem> problems = check_scene(idle);
+    ASSERT_EQ(problems.size(), 1u);
+    EXPECT_FALSE(problems[0].error);
+    EXPECT_EQ(problems[0].line, 4);
+    EXPECT_NE(problems[0].problem.find("fills nothing"), std::string::npos) << problems[0].problem;
+    EXPECT_FALSE(load_scene(idle)->has_media());
     // What loads: the medium reaches the shape and the camera.
     auto scene = load_scene(write_temp_scene(R"(<scene version="3.0.0"><medium type="homogeneous" id="fog"/>
       <sensor type="perspective"><ref id="fog"/><film type="hdrfilm"><integer name="width" value="8"/><integer name="height" value="8"/></film></sensor>

@@ -2,6 +2,7 @@
 // referenced many times (a BSDF used by many shapes) becomes one object.
 #pragma once
 #include <map>
+#include <set>
 #include <memory>
 #include "neepp/base/bsdf.h"
 #include "neepp/io/xml_tree.h"
@@ -28,7 +29,10 @@ public:
     void shape(const XmlNode &node, Scene &scene);
     void emitter(const XmlNode &node, Scene &scene);
     // A <medium> (made once however many shapes name it); the scene holds it after give_media_to.
-    const Medium *medium(const XmlNode &node);
+    // `used`: a shape or the sensor names it (false: only declared, at the top level).
+    const Medium *medium(const XmlNode &node, bool used = true);
+    // Warns of each medium that was declared but that no shape bounds and no sensor sits in.
+    void warn_unused_media() const;
     std::shared_ptr<const Volume> volume_param(const XmlNode &node, const std::string &name, Color def);
     void give_media_to(Scene &scene) const;
 
@@ -52,6 +56,7 @@ private:
     std::map<const XmlNode *, std::vector<std::unique_ptr<Shape>>> shape_groups_;
     BSDFPtr default_bsdf_, black_bsdf_;
     std::map<const XmlNode *, std::shared_ptr<const Medium>> media_;
+    std::set<const XmlNode *> used_media_;
 };
 
 // f(), with any error it throws that does not say where (a plugin's, a constructor's) located at node.

@@ -67,7 +67,8 @@ std::shared_ptr<const Volume> Factories::volume_param(const XmlNode &node, const
     return std::make_shared<ConstantVolume>(node.get_rgb(name, def));
 }
 
-const Medium *Factories::medium(const XmlNode &node) {
+const Medium *Factories::medium(const XmlNode &node, bool used) {
+    if (used) used_media_.insert(&node);
     if (auto it = media_.find(&node); it != media_.end()) return it->second.get();
     if (node.tag != "medium") throw node.error("expected a <medium>, found <" + node.tag + ">");
     if (node.type != "homogeneous" && node.type != "heterogeneous")
@@ -109,8 +110,18 @@ const Medium *Factories::medium(const XmlNode &node) {
     return m.get();
 }
 
+void Factories::warn_unused_media() const {
+    // Mitsuba renders such a scene as if the medium were not there; most likely a shape or the sensor was
+    // meant to <ref> it.
+    for (const auto &[node, m] : media_)
+        if (!used_media_.count(node))
+            warn(node->file, node->line, "this medium fills nothing: no shape names it as its interior or exterior "
+                                         "and no sensor sits in it, so it changes no image");
+}
+
 void Factories::give_media_to(Scene &scene) const {
-    for (const auto &[node, m] : media_) scene.add_medium(m);
+    for (const auto &[node, m] : media_)
+        if (used_media_.count(node)) scene.add_medium(m);
 }
 
 }  // namespace neepp::loader

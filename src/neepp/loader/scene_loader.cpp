@@ -187,11 +187,12 @@ std::unique_ptr<Scene> read_scene(const std::string &path, const std::map<std::s
             // no shape uses is checked too).
             if (loader::checking()) tag == "bsdf" ? (void)factories.bsdf(*node) : (void)factories.texture(*node);
         } else if (tag == "medium") {
-            factories.medium(*node);  // declared for the shapes and the sensor that <ref> it
+            factories.medium(*node, false);  // declared for the shapes and the sensor that <ref> it
         } else {
             throw node->error("unsupported element <" + tag + "> at the top level of the scene");
         }
     });
+    factories.warn_unused_media();
     factories.give_media_to(*scene);
     if (!have_sensor) {
         scene->camera.finalize();  // Mitsuba's default sensor would look from the origin; warn instead of guessing
