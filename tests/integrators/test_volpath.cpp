@@ -86,7 +86,9 @@ TEST(VolPath, HeterogeneousSlabTransmitsItsIntegral) {
     const double tau = scale * integral * h;
     expect_mean(out.image, Color(float(std::exp(-tau)), float(std::exp(-0.5 * tau)), float(std::exp(-2 * tau))), "grid");
 
-    std::string flat = slab_xml(h, R"(<volume name="sigma_t" type="constvolume"><rgb name="value" value="0.25, 0.75, 1"/></volume>
+    // A constant volume is defined over the unit cube placed by its to_world (Mitsuba's): here the slab.
+    std::string flat = slab_xml(h, R"(<volume name="sigma_t" type="constvolume"><rgb name="value" value="0.25, 0.75, 1"/>
+                                        <transform name="to_world"><scale x="100" y="100" z="0.8"/><translate x="-50" y="-50" z="-0.4"/></transform></volume>
                                       <float name="scale" value="2"/><float name="albedo" value="0"/>)",
                                 R"(<emitter type="constant"><rgb name="radiance" value="1"/></emitter>)", -1);
     flat.replace(flat.find(homogeneous), homogeneous.size(), heterogeneous);

@@ -85,3 +85,11 @@ TEST(GridVolume, RefusesBadGrids) {
     nan.values[5] = std::nanf("");
     EXPECT_THROW(GridVolume(nan, {}), std::invalid_argument);
 }
+
+TEST(ConstantVolume, IsDefinedOverTheUnitCubeItsToWorldPlaces) {
+    const ConstantVolume v(Color(0.5f, 0.4f, 0.3f), Transform::translate(Vec3(-0.5f)));
+    EXPECT_EQ(v.bounds().lo, Vec3(-0.5f));
+    EXPECT_EQ(v.bounds().hi, Vec3(0.5f));
+    EXPECT_FLOAT_EQ(v.max(), 0.5f);
+    EXPECT_EQ(ConstantVolume(Color(1.f)).bounds().hi, Vec3(1.f));
+}

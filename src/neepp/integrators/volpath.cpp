@@ -7,8 +7,8 @@
 // clear part, a thin dielectric's transmission) are not.
 //
 // In RGB, media may attenuate the channels differently. One channel, drawn once per path (the hero), drives
-// every distance the path and its shadow rays sample; each channel's weight is its own probability over
-// the hero's density (Mitsuba's spectral extinction).
+// every distance the path and its shadow rays sample; the path's weight is its contribution over the mean
+// of the densities each channel would have given it (Mitsuba's volpathmis, one-sample MIS over channels).
 #include <algorithm>
 #include <cmath>
 
@@ -32,11 +32,14 @@ struct PathIntegrator::ScatteringPoint {
 
 namespace {
 
-// What a free flight through a medium met before the surface ahead.
+// What a free flight through a medium met before the surface ahead: the event, and its contribution f and
+// density p in each channel, had that channel drawn the distance (the event's choice, real or null, is the
+// same whichever did).
 struct FreeFlight {
     enum Event { Passed, Real, Null } event = Passed;
-    float t = 0;          // where the collision is, along the ray
-    Color weight{1.f};    // the path throughput's factor: f / p of the flight and the event chosen
+    float t = 0;     // where the collision is, along the ray
+    Color f{1.f};    // transmittance to it, times sigma_s (real) or sigma_n (null)
+    Color pdf{1.f};  // the density of this distance (and event) in each channel
 };
 
 // A distance drawn in `channel` against the majorant from where the ray starts (tmin) up to t_end (delta
@@ -50,29 +53,21 @@ FreeFlight sample_free_flight(const Medium &medium, const Ray &ray, float t_end,
     const Color majorant = medium.majorant();
     const float m = majorant[channel];
     const float t = m > 0 ? t0 - std::log(1.f - sampler.next_1d()) / m : kInfinity;
-    if (!(t < t1)) {
-        // Through to the end: the probability of no collision in each channel, over the hero's.
-        f.weight = vexp(-(majorant - Color(m)) * (t1 - t0));
+    if (!(t < t1)) {  // through to the end: no collision, in each channel with probability e^{-majorant d}
+        f.f = f.pdf = vexp(-majorant * (t1 - t0));
         return f;
     }
     f.t = t;
-    // The density of colliding here in the hero channel is m e^{-m (t - t0)}.
-    const Color flight = vexp(-(majorant - Color(m)) * (t - t0)) * (majorant / m);
+    const Color tr = vexp(-majorant * (t - t0));
     const MediumCoefficients c = medium.at(r.at(t));
     const Color sigma_n = majorant - c.sigma_t;
     float p_null = 0.f;
     for (int k = 0; k < 3; ++k)
         if (majorant[k] > 0) p_null += sigma_n[k] / majorant[k] / 3.f;
-    if (p_null > 0.f && sampler.next_1d() < p_null) {
-        f.event = FreeFlight::Null;
-        f.weight = flight * sigma_n / (majorant * p_null);
-    } else {
-        f.event = FreeFlight::Real;
-        f.weight = flight * c.sigma_s / (majorant * (1.f - p_null));
-    }
-    // Where the majorant is 0 in a channel nothing collides in it: its share of the weight is 0.
-    for (int k = 0; k < 3; ++k)
-        if (!(majorant[k] > 0)) f.weight[k] = 0.f;
+    const bool null = p_null > 0.f && sampler.next_1d() < p_null;
+    f.event = null ? FreeFlight::Null : FreeFlight::Real;
+    f.f = tr * (null ? sigma_n : c.sigma_s);
+    f.pdf = tr * majorant * (null ? p_null : 1.f - p_null);
     return f;
 }
 
@@ -120,6 +115,10 @@ Color PathIntegrator::Li_volumetric(const Scene &scene, const Ray &camera_ray, S
     Ray ray = camera_ray;
     const Medium *medium = scene.camera.medium;
     const int channel = scene.has_media() ? std::min(int(sampler.next_1d() * 3.f), 2) : 0;
+    // The path's density had each channel drawn its distances, over their mean (Mitsuba's volpathmis): the
+    // throughput is f over that mean, one-sample MIS between the channels by the balance heuristic, so that
+    // a channel the hero samples badly (a chromatic medium) does not carry huge weights.
+    Color pdf_ratio(1.f);
     int depth = 0;  // scattering vertices so far: collisions in media and surfaces that are not null
     // The last scattering vertex, for the MIS weight of emission that a ray sampled there finds (null
     // events in between change neither it nor its density).
@@ -138,7 +137,12 @@ Color PathIntegrator::Li_volumetric(const Scene &scene, const Ray &camera_ray, S
         // In a medium: a collision before the surface ahead, or none.
         if (medium) {
             const FreeFlight flight = sample_free_flight(*medium, ray, hit ? si.t : ray.tmax, channel, sampler);
-            beta *= flight.weight;
+            const Color p = pdf_ratio * flight.pdf;
+            const float mean = (p.x + p.y + p.z) / 3.f;
+            if (!(mean > 0)) break;
+            beta *= flight.f / mean;
+            pdf_ratio = p / mean;
+            if (!(max_component(beta) > 0)) break;  // absorbed (an albedo of 0)
             if (flight.event == FreeFlight::Null) {  // on along the same ray, toward the same surface
                 ray.tmin = flight.t;
                 continue;

@@ -23,7 +23,7 @@ std::shared_ptr<const PhaseFunction> make_phase(const XmlNode &node) {
 // A <volume> (constvolume or gridvolume) as Mitsuba 3 reads it.
 std::shared_ptr<const Volume> make_volume(const XmlNode &node) {
     if (node.type == "constvolume")
-        return std::make_shared<ConstantVolume>(node.get_unbounded_rgb("value", Color(1.f)));
+        return std::make_shared<ConstantVolume>(node.get_unbounded_rgb("value", Color(1.f)), node.get_transform("to_world"));
     if (node.type != "gridvolume" && node.type != "grid")
         throw node.error("unsupported volume '" + node.type + "' (supported: constvolume, gridvolume)");
     GridVolumeOptions o;

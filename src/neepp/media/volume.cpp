@@ -6,6 +6,12 @@
 
 namespace neepp {
 
+BBox unit_cube_bounds(const Transform &to_world) {
+    BBox b;
+    for (int k = 0; k < 8; ++k) b.expand(to_world.point(Vec3(float(k & 1), float(k >> 1 & 1), float(k >> 2 & 1))));
+    return b;
+}
+
 GridVolume::GridVolume(VolumeGrid grid, const GridVolumeOptions &options) : grid_(std::move(grid)), options_(options) {
     if (grid_.channels != 1 && grid_.channels != 3)
         throw std::invalid_argument("a gridvolume has 1 or 3 channels, this grid " + std::to_string(grid_.channels));
@@ -23,7 +29,7 @@ GridVolume::GridVolume(VolumeGrid grid, const GridVolumeOptions &options) : grid
         to_world = to_world * Transform::translate(lo) * Transform::scale(extent);
     }
     to_local_ = Transform(to_world.inverse_matrix, to_world.matrix);
-    for (int k = 0; k < 8; ++k) bounds_.expand(to_world.point(Vec3(float(k & 1), float(k >> 1 & 1), float(k >> 2 & 1))));
+    bounds_ = unit_cube_bounds(to_world);
 }
 
 int64_t GridVolume::wrap(int64_t i, uint32_t n) const {

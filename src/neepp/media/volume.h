@@ -14,19 +14,25 @@ public:
     virtual Color eval(const Vec3 &p) const = 0;
     // The largest value of any channel anywhere (a heterogeneous medium's majorant comes from it).
     virtual float max() const = 0;
-    // Where it is defined, in world space (a constant: everywhere).
+    // Where it is defined, in world space: as Mitsuba's, the unit cube placed by to_world (a heterogeneous
+    // medium is vacuum outside its sigma_t volume's bounds, even a constant one's).
     virtual BBox bounds() const = 0;
 };
 
+// The unit cube's box after to_world.
+BBox unit_cube_bounds(const Transform &to_world);
+
 class ConstantVolume final : public Volume {
 public:
-    explicit ConstantVolume(Color value) : value_(value) {}
+    explicit ConstantVolume(Color value, const Transform &to_world = Transform())
+        : value_(value), bounds_(unit_cube_bounds(to_world)) {}
     Color eval(const Vec3 &) const override { return value_; }
     float max() const override { return max_component(value_); }
-    BBox bounds() const override { return BBox{Vec3(-kInfinity), Vec3(kInfinity)}; }
+    BBox bounds() const override { return bounds_; }
 
 private:
     Color value_;
+    BBox bounds_;
 };
 
 struct GridVolumeOptions {
