@@ -170,6 +170,13 @@ Color PathIntegrator::sample_direct(const Scene &scene, const SurfaceInteraction
     return q.unoccluded * test_visibility(*queries_, scene, q, sampler, counters);
 }
 
+bool PathIntegrator::survives_roulette(Color &beta, float eta, Sampler &sampler) {
+    const float q = std::min(max_component(beta) * eta * eta, 0.95f);
+    if (!(sampler.next_1d() < q)) return false;
+    beta /= q;
+    return true;
+}
+
 Color PathIntegrator::Li(const Scene &scene, const Ray &camera_ray, Sampler &sampler, RenderCounters &counters) const {
     if (options_.volumetric) return Li_volumetric(scene, camera_ray, sampler, counters);
     Color L(0.f), beta(1.f);  // radiance so far, and the path throughput f·cos/pdf up to the current vertex
@@ -226,12 +233,7 @@ Color PathIntegrator::Li(const Scene &scene, const Ray &camera_ray, Sampler &sam
         prev_delta = (bs.sampled_flags & BSDFDelta) != 0;
         ray = si.spawn_ray(si.to_world(bs.wo));
 
-        // Russian roulette on the throughput (times eta² so that refraction does not trigger it), Mitsuba's rule.
-        if (depth + 1 >= options_.rr_depth) {
-            const float q = std::min(max_component(beta) * eta * eta, 0.95f);
-            if (!(sampler.next_1d() < q)) break;
-            beta /= q;
-        }
+        if (depth + 1 >= options_.rr_depth && !survives_roulette(beta, eta, sampler)) break;
         if (!(max_component(beta) > 0)) break;
     }
     return L;

@@ -85,6 +85,9 @@ private:
     // MIS weight for emission found by a BSDF-sampled ray leaving prev (pdf prev_pdf) toward light.
     float emission_weight(const Light &light, const LightSampleContext &prev, const DirectionSample &ds,
                           float prev_pdf) const;
+    // Russian roulette on the throughput (times eta², so that refraction does not trigger it), Mitsuba's
+    // rule: false ends the path; a survivor's beta is divided by its survival probability.
+    static bool survives_roulette(Color &beta, float eta, Sampler &sampler);
     // Light-sample candidates at a vertex of this depth: options_.ris at the first ris_depth, else 1.
     int candidates_at(int depth) const {
         return options_.ris_depth < 0 || depth < options_.ris_depth ? options_.ris : 1;

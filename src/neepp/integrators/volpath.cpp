@@ -165,11 +165,7 @@ Color PathIntegrator::Li_volumetric(const Scene &scene, const Ray &camera_ray, S
                 prev_delta = !medium->sample_emitters;
                 ray = Ray{v.p, ps.wo, 0.f, kInfinity};
                 need_hit = true;
-                if (depth > options_.rr_depth) {
-                    const float q = std::min(max_component(beta) * eta * eta, 0.95f);
-                    if (!(sampler.next_1d() < q)) break;
-                    beta /= q;
-                }
+                if (depth > options_.rr_depth && !survives_roulette(beta, eta, sampler)) break;
                 if (!(max_component(beta) > 0)) break;
                 continue;
             }
@@ -225,11 +221,7 @@ Color PathIntegrator::Li_volumetric(const Scene &scene, const Ray &camera_ray, S
         prev = v.ctx;
         prev_pdf = bs.pdf;
         prev_delta = (bs.sampled_flags & BSDFDelta) != 0;
-        if (depth > options_.rr_depth) {
-            const float q = std::min(max_component(beta) * eta * eta, 0.95f);
-            if (!(sampler.next_1d() < q)) break;
-            beta /= q;
-        }
+        if (depth > options_.rr_depth && !survives_roulette(beta, eta, sampler)) break;
         if (!(max_component(beta) > 0)) break;
     }
     return L;

@@ -338,9 +338,7 @@ std::unique_ptr<Shape> Factories::build_shape(const XmlNode &node, const XmlNode
                 if (name != "interior" && name != "exterior")
                     throw child->error("a shape's medium is its \"interior\" or its \"exterior\" (name it so), not \"" +
                                        name + "\"");
-                const Medium *&slot = name == "interior" ? s->interior : s->exterior;
-                if (slot) throw child->error("the shape has two " + name + " media");
-                slot = medium(*child);
+                (name == "interior" ? s->interior : s->exterior) = medium(*child);
             } else {
                 throw child->error("unsupported inside a shape: <" + child->tag + ">");
             }

@@ -133,4 +133,18 @@ bool Transform::preserves_lengths(float tolerance) const {
     return true;
 }
 
+float uniform_scale(const Transform &to_world, const std::string &what) {
+    Vec3 axes[3];
+    float scale[3];
+    for (int i = 0; i < 3; ++i) {
+        axes[i] = to_world.vector(Vec3(i == 0, i == 1, i == 2));
+        scale[i] = norm(axes[i]);
+    }
+    const float tol = 1e-4f * scale[0] * scale[0];
+    if (std::abs(scale[1] - scale[0]) > 1e-4f * scale[0] || std::abs(scale[2] - scale[0]) > 1e-4f * scale[0] ||
+        std::abs(dot(axes[0], axes[1])) > tol || std::abs(dot(axes[0], axes[2])) > tol || std::abs(dot(axes[1], axes[2])) > tol)
+        throw std::runtime_error(what + " must scale uniformly (and not shear)");
+    return scale[0];
+}
+
 }  // namespace neepp

@@ -1,6 +1,7 @@
 // 4x4 affine/projective transforms (row-major), as used by Mitsuba's <transform> element.
 #pragma once
 #include <array>
+#include <string>
 #include "neepp/math/vec.h"
 
 namespace neepp {
@@ -12,6 +13,11 @@ struct Matrix4 {
     Matrix4 inverse() const;  // general inverse; throws std::runtime_error on a singular matrix
     Matrix4 transpose() const;
 };
+
+struct Transform;
+// The scale of a to_world that scales all directions alike (it may also translate, rotate and mirror);
+// throws std::runtime_error, naming it (what), for one that shears or scales some directions more than others.
+float uniform_scale(const Transform &to_world, const std::string &what);
 
 struct Transform {
     Matrix4 matrix = Matrix4::identity(), inverse_matrix = Matrix4::identity();

@@ -3,7 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
-#include "neepp/shapes/sphere.h"
+
 
 namespace neepp {
 namespace {

@@ -26,8 +26,4 @@ public:
     void digest(GeometryDigest &d) const override;
 };
 
-// The scale of a to_world that scales all directions alike (it may also translate, rotate and mirror);
-// throws, naming it (what), for one that shears or scales some directions more than others.
-float uniform_scale(const Transform &to_world, const std::string &what);
-
 }  // namespace neepp
