@@ -44,7 +44,8 @@ __all__ = ["render", "schedule_rounds"]
 
 # Statistics that add up over ranges.
 _SUMMED = ["rays", "camera_rays", "light_rays", "splats", "shadow_rays", "shadow_rays_occluded",
-           "shadow_rays_skipped", "occlusion_time_s", "invalid_samples"]
+           "shadow_rays_skipped", "occlusion_time_s", "invalid_samples", "density_lookups",
+           "transmittance_lookups", "medium_shadow_rays"]
 
 _scenes: Dict[str, object] = {}  # a worker process's loaded scenes (Ray reuses processes across tasks)
 

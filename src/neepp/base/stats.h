@@ -15,11 +15,19 @@ struct RenderCounters {
     // contributions splatted onto the film through camera connections.
     uint64_t light_rays = 0;
     uint64_t splats = 0;
+    // Participating media: density lookups by the paths' free flights, and by the shadow rays'
+    // transmittance estimates (ratio tracking: what a shadow ray that NEE++ skips saves), and the shadow
+    // rays that crossed a medium.
+    uint64_t density_lookups = 0;
+    uint64_t transmittance_lookups = 0;
+    uint64_t medium_shadow_rays = 0;
 
     RenderCounters &operator+=(const RenderCounters &o) {
         rays += o.rays; shadow_rays += o.shadow_rays; shadow_rays_occluded += o.shadow_rays_occluded;
         shadow_rays_skipped += o.shadow_rays_skipped; occlusion_ticks += o.occlusion_ticks;
         invalid_samples += o.invalid_samples; light_rays += o.light_rays; splats += o.splats;
+        density_lookups += o.density_lookups; transmittance_lookups += o.transmittance_lookups;
+        medium_shadow_rays += o.medium_shadow_rays;
         return *this;
     }
 };

@@ -16,6 +16,7 @@
 #include "neepp/base/medium.h"
 #include "neepp/integrators/path.h"
 #include "neepp/math/warp.h"
+#include "neepp/media/free_flight.h"
 #include "neepp/sampling/sampler.h"
 #include "neepp/scene/scene.h"
 #include "neepp/visibility/transmittance.h"
@@ -29,49 +30,6 @@ struct PathIntegrator::ScatteringPoint {
     const Medium *medium = nullptr;          // the medium the path is in there
     LightSampleContext ctx;
 };
-
-namespace {
-
-// What a free flight through a medium met before the surface ahead: the event, and its contribution f and
-// density p in each channel, had that channel drawn the distance (the event's choice, real or null, is the
-// same whichever did).
-struct FreeFlight {
-    enum Event { Passed, Real, Null } event = Passed;
-    float t = 0;     // where the collision is, along the ray
-    Color f{1.f};    // transmittance to it, times sigma_s (real) or sigma_n (null)
-    Color pdf{1.f};  // the density of this distance (and event) in each channel
-};
-
-// A distance drawn in `channel` against the majorant from where the ray starts (tmin) up to t_end (delta
-// tracking); at a collision, real with probability avg(sigma_t / majorant), else null.
-FreeFlight sample_free_flight(const Medium &medium, const Ray &ray, float t_end, int channel, Sampler &sampler) {
-    FreeFlight f;
-    Ray r = ray;
-    r.tmax = std::min(ray.tmax, t_end);
-    float t0, t1;
-    if (!medium.overlap(r, t0, t1)) return f;
-    const Color majorant = medium.majorant();
-    const float m = majorant[channel];
-    const float t = m > 0 ? t0 - std::log(1.f - sampler.next_1d()) / m : kInfinity;
-    if (!(t < t1)) {  // through to the end: no collision, in each channel with probability e^{-majorant d}
-        f.f = f.pdf = vexp(-majorant * (t1 - t0));
-        return f;
-    }
-    f.t = t;
-    const Color tr = vexp(-majorant * (t - t0));
-    const MediumCoefficients c = medium.at(r.at(t));
-    const Color sigma_n = majorant - c.sigma_t;
-    float p_null = 0.f;
-    for (int k = 0; k < 3; ++k)
-        if (majorant[k] > 0) p_null += sigma_n[k] / majorant[k] / 3.f;
-    const bool null = p_null > 0.f && sampler.next_1d() < p_null;
-    f.event = null ? FreeFlight::Null : FreeFlight::Real;
-    f.f = tr * (null ? sigma_n : c.sigma_s);
-    f.pdf = tr * majorant * (null ? p_null : 1.f - p_null);
-    return f;
-}
-
-}  // namespace
 
 Color PathIntegrator::sample_direct_volumetric(const Scene &scene, const ScatteringPoint &v, const Color &beta,
                                                int channel, Sampler &sampler, RenderCounters &counters) const {
@@ -137,6 +95,7 @@ Color PathIntegrator::Li_volumetric(const Scene &scene, const Ray &camera_ray, S
         // In a medium: a collision before the surface ahead, or none.
         if (medium) {
             const FreeFlight flight = sample_free_flight(*medium, ray, hit ? si.t : ray.tmax, channel, sampler);
+            counters.density_lookups += flight.event != FreeFlight::Passed;
             const Color p = pdf_ratio * flight.pdf;
             const float mean = (p.x + p.y + p.z) / 3.f;
             if (!(mean > 0)) break;

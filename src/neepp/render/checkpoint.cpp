@@ -10,7 +10,8 @@ namespace neepp {
 namespace {
 
 constexpr char kMagic[8] = {'N', 'E', 'E', 'P', 'P', 'C', 'K', 'P'};
-constexpr uint32_t kVersion = 1;
+// Version 2: the counters gained the media counters (density and transmittance lookups).
+constexpr uint32_t kVersion = 2;
 static_assert(std::is_trivially_copyable_v<RenderCounters>);
 
 }  // namespace

@@ -50,6 +50,8 @@ public:
         uint64_t pixel = (uint64_t(py) << 32) | px;
         rng_.seed(mix_bits(seed_ ^ mix_bits(pixel)), mix_bits(sample_index + (seed_ << 32)));
     }
+    // Starts the sequence that PCG32(init_state, stream) gives, for a caller that derives its own seeds.
+    void start_stream(uint64_t init_state, uint64_t stream) { rng_.seed(init_state, stream); }
     float next_1d() override { return rng_.next_float(); }
     Vec2 next_2d() override { return rng_.next_2d(); }
     std::unique_ptr<Sampler> clone() const override { return std::make_unique<IndependentSampler>(seed_); }

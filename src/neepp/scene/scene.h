@@ -84,6 +84,7 @@ public:
     // Keeps a medium that shapes and the camera point to.
     const Medium *add_medium(std::shared_ptr<const Medium> medium);
     bool has_media() const { return !media_.empty(); }
+    const std::vector<std::shared_ptr<const Medium>> &media() const { return media_; }
     const std::vector<std::unique_ptr<Shape>> &shapes() const { return shapes_; }
     const std::vector<LightPtr> &lights() const { return lights_; }
     std::vector<const Light *> light_pointers() const;

@@ -35,6 +35,30 @@ uint64_t scene_fingerprint(const Scene &scene) {
     }
     mix(&scene.bounds().lo, sizeof(Vec3));
     mix(&scene.bounds().hi, sizeof(Vec3));
+    if (scene.has_media()) {
+        // Media change what the map learns (expected transmittance): their bounds on density, and which
+        // media the shapes bound and the camera sits in. Media-free scenes keep the fingerprint they had.
+        const auto &media = scene.media();
+        auto index_of = [&](const Medium *m) {
+            int32_t i = -1;
+            for (size_t k = 0; k < media.size(); ++k)
+                if (media[k].get() == m) i = int32_t(k);
+            return i;
+        };
+        mix("media", 5);
+        for (const auto &m : media) {
+            const Color majorant = m->majorant();
+            const uint8_t flags = uint8_t(m->homogeneous()) | uint8_t(m->sample_emitters << 1);
+            mix(&majorant, sizeof majorant);
+            mix(&flags, 1);
+        }
+        for (const auto &s : scene.shapes()) {
+            const int32_t sides[2] = {index_of(s->interior), index_of(s->exterior)};
+            mix(sides, sizeof sides);
+        }
+        const int32_t camera = index_of(scene.camera.medium);
+        mix(&camera, sizeof camera);
+    }
     return h;
 }
 

@@ -8,8 +8,11 @@
 #include "neepp/math/denormals.h"
 #include "neepp/math/frame.h"
 #include "neepp/math/warp.h"
+#include "neepp/media/free_flight.h"
 #include "neepp/sampling/rng.h"
+#include "neepp/sampling/sampler.h"
 #include "neepp/scene/scene.h"
+#include "neepp/visibility/transmittance.h"
 
 namespace neepp {
 
@@ -17,7 +20,10 @@ namespace {
 
 struct CellPoint {
     Vec3 p;
-    Vec3 n;  // surface points: geometric normal on the side the path arrived from; light points: light normal (or 0)
+    // Surface points: the geometric normal on the side the path arrived from; points in a medium: 0; light
+    // points: the light's normal (or 0).
+    Vec3 n;
+    const Medium *medium = nullptr;  // where shadow rays from the point start (on the side of n)
 };
 
 // Reservoir sampling of up to k items per cell, in a fixed insertion order with a fixed generator.
@@ -48,26 +54,86 @@ struct Prepass {
     std::vector<uint8_t> len;
 };
 
+// The points of one pre-pass path in a scene without media: every surface it meets, leaving each by a
+// cosine-sampled direction on the side it arrived from.
+void surface_path(const Scene &scene, Ray ray, int B, Sampler &s, CellPoint *points, uint8_t &len) {
+    for (int b = 0; b < B; ++b) {
+        SurfaceInteraction si;
+        if (!scene.intersect(ray, si)) break;
+        Vec3 n = dot(si.n, ray.d) > 0 ? -si.n : si.n;  // the side the path arrived from
+        points[b] = {si.p, n};
+        len = uint8_t(b + 1);
+        Vec3 d = Frame(n).to_world(square_to_cosine_hemisphere(s.next_2d()));
+        ray = spawn_ray(si.p, n, d);
+    }
+}
+
+// With media, where NEE happens also includes the points where paths scatter in them (a voxel inside fog
+// may hold no surface at all). The path draws its distances by delta tracking, scatters in a medium
+// toward a uniform direction, passes through surfaces that NEE never shades (a null boundary, a thin
+// dielectric's transmission) and follows mirror-like ones as their BSDF samples them, keeping track of the
+// medium it is in; each point keeps the medium its shadow rays start in.
+void media_path(const Scene &scene, Ray ray, int B, Sampler &s, CellPoint *points, uint8_t &len) {
+    const Medium *medium = scene.camera.medium;
+    const int channel = std::min(int(s.next_1d() * 3.f), 2);
+    SurfaceInteraction si;
+    bool hit = false, need_hit = true;
+    // Null collisions and crossings record nothing: a bound on them keeps a path in a dense
+    // heterogeneous medium, or between two facing thin sheets, from running long.
+    constexpr int kMaxEvents = 256;
+    int b = 0;
+    for (int event = 0; b < B && event < kMaxEvents; ++event) {
+        if (need_hit) hit = scene.intersect(ray, si), need_hit = false;
+        if (medium) {
+            const FreeFlight flight = sample_free_flight(*medium, ray, hit ? si.t : ray.tmax, channel, s);
+            if (flight.event == FreeFlight::Null) {
+                ray.tmin = flight.t;
+                continue;
+            }
+            if (flight.event == FreeFlight::Real) {
+                const Vec3 p = ray.at(flight.t);
+                points[b++] = {p, Vec3(0.f), medium};
+                ray = Ray{p, square_to_uniform_sphere(s.next_2d()), 0.f, kInfinity};
+                need_hit = true;
+                continue;
+            }
+        }
+        if (!hit) break;
+        const Vec3 n = dot(si.n, ray.d) > 0 ? -si.n : si.n;  // the side the path arrived from
+        Vec3 d;
+        if (si.shape->bsdf_flags & BSDFSmooth) {
+            const Medium *side = si.shape->is_medium_transition() ? si.shape->medium_toward(n, si.n) : medium;
+            points[b++] = {si.p, n, side};
+            d = Frame(n).to_world(square_to_cosine_hemisphere(s.next_2d()));
+        } else {
+            const float u1 = s.next_1d();
+            const BSDFSample bs = si.shape->bsdf->sample(BSDFContext{}, si, si.wi, u1, s.next_2d());
+            if (!bs.valid()) break;
+            d = si.to_world(bs.wo);
+        }
+        if (si.shape->is_medium_transition()) medium = si.shape->medium_toward(d, si.n);
+        ray = si.spawn_ray(d);
+        need_hit = true;
+    }
+    len = uint8_t(b);
+}
+
 Prepass camera_prepass(const Scene &scene, const SeedingOptions &opt) {
     const int G = std::max(1, opt.camera_grid), B = std::max(1, opt.bounces);
     const size_t paths = size_t(G) * G;
     Prepass pre{B, std::vector<CellPoint>(paths * B), std::vector<uint8_t>(paths, 0)};
+    const bool media = scene.has_media();
     tbb::parallel_for(tbb::blocked_range<size_t>(0, paths, 256), [&](const tbb::blocked_range<size_t> &r) {
         const DenormalsAreZero ftz;
+        IndependentSampler s(0);
         for (size_t i = r.begin(); i != r.end(); ++i) {
-            PCG32 rng(mix_bits(opt.seed ^ mix_bits(i)), 1);
-            Vec2 film{(float(i % G) + rng.next_float()) / float(G), (float(i / G) + rng.next_float()) / float(G)};
-            const Vec2 lens = scene.camera.has_lens() ? rng.next_2d() : Vec2(0.5f, 0.5f);
-            Ray ray = scene.camera.generate_ray(film, lens);
-            for (int b = 0; b < B; ++b) {
-                SurfaceInteraction si;
-                if (!scene.intersect(ray, si)) break;
-                Vec3 n = dot(si.n, ray.d) > 0 ? -si.n : si.n;  // the side the path arrived from
-                pre.points[i * B + b] = {si.p, n};
-                pre.len[i] = uint8_t(b + 1);
-                Vec3 d = Frame(n).to_world(square_to_cosine_hemisphere(rng.next_2d()));
-                ray = spawn_ray(si.p, n, d);
-            }
+            s.start_stream(mix_bits(opt.seed ^ mix_bits(i)), 1);
+            const float jx = s.next_1d(), jy = s.next_1d();
+            const Vec2 film{(float(i % G) + jx) / float(G), (float(i / G) + jy) / float(G)};
+            const Vec2 lens = scene.camera.has_lens() ? s.next_2d() : Vec2(0.5f, 0.5f);
+            const Ray ray = scene.camera.generate_ray(film, lens);
+            if (media) media_path(scene, ray, B, s, &pre.points[i * B], pre.len[i]);
+            else surface_path(scene, ray, B, s, &pre.points[i * B], pre.len[i]);
         }
     });
     return pre;
@@ -149,6 +215,7 @@ SeedingStats seed_visibility_map(const Scene &scene, const VoxelGrid &grid, Visi
     //    policies always trace them. Samples whose direction lies behind the shading point's surface, or
     //    that reach an area light from its back, are not traced: NEE never asks for them (the BSDF or the
     //    emission is zero there), and counting them would bias the pair's estimate toward their outcome.
+    const bool media = scene.has_media();
     struct PairJob { uint32_t a, b; };
     std::vector<PairJob> jobs;
     for (uint32_t a : shading_cells)
@@ -162,15 +229,40 @@ SeedingStats seed_visibility_map(const Scene &scene, const VoxelGrid &grid, Visi
             const auto &ys = light_ends.items[jobs[j].b];
             const bool infinite = grid.is_direction_cell(jobs[j].b);
             PCG32 rng(mix_bits(opt.seed ^ mix_bits((uint64_t(jobs[j].a) << 32) | jobs[j].b)), 5);
+            IndependentSampler tracking(0);  // for the free flights of transmittance estimates
+            if (media) tracking.start_stream(rng.next_u32(), 6);
             uint32_t visible = 0, traced = 0;
+            float through = 0.f;  // with media: the sum of the traced rays' transmittances
             for (int s = 0; s < opt.samples_per_pair; ++s) {
                 const CellPoint &x = xs[std::min(xs.size() - 1, size_t(rng.next_float() * float(xs.size())))];
                 const CellPoint &y = ys[std::min(ys.size() - 1, size_t(rng.next_float() * float(ys.size())))];
                 Vec3 d = infinite ? y.p : y.p - x.p;
-                if (dot(d, x.n) <= 0) continue;
+                const bool on_surface = squared_norm(x.n) > 0;
+                if (on_surface && dot(d, x.n) <= 0) continue;
                 if (!infinite && dot(y.n, d) >= 0 && squared_norm(y.n) > 0) continue;
                 ++traced;
-                visible += !scene.occluded(ray_between(x.p, x.n, y.p, infinite));
+                if (!media) {
+                    visible += !scene.occluded(ray_between(x.p, x.n, y.p, infinite));
+                    continue;
+                }
+                Ray ray;
+                if (on_surface) ray = ray_between(x.p, x.n, y.p, infinite);
+                else if (infinite) ray = Ray{x.p, d, 0.f, kInfinity};
+                else {
+                    const float dist = norm(d);
+                    if (!(dist > 0)) continue;
+                    ray = Ray{x.p, d / dist, 0.f, dist * (1.f - kShadowEpsilon)};
+                }
+                RenderCounters ignored;
+                const Color T = trace_transmittance(scene, ray, x.medium, s % 3, tracking, ignored);
+                through += (T.x + T.y + T.z) * (1.f / 3.f);
+            }
+            // The map counts rays that got through; with media, the sum of transmittances rounded up or down
+            // at random in proportion, so that the count's expectation is the expected transmittance's.
+            if (media) {
+                const float whole = std::floor(through);
+                visible = uint32_t(whole) + (rng.next_float() < through - whole);
+                visible = std::min(visible, traced);
             }
             results[j] = {uint16_t(visible), uint16_t(traced)};
         }

@@ -7,6 +7,9 @@
 //     lights): the other ends of the shadow rays NEE will trace;
 //  3. for every (occupied shading voxel, light cell) pair, samples_per_pair shadow rays are traced
 //     between random stored points of the two cells and their outcomes become the pair's counts.
+// With participating media, step 1 also records where paths scatter in them, and the samples of step 3
+// are transmittances through media and the surfaces that let light through: the map then holds expected
+// transmittance, what NEE++ learns from rendering's shadow rays in such scenes.
 // Everything is drawn from fixed per-path / per-pair seeds, so the map is the same on any thread count.
 #pragma once
 #include <cstdint>
@@ -32,7 +35,7 @@ struct SeedingStats {
     double time_s = 0;
     uint64_t camera_rays = 0;      // closest-hit queries of the pre-pass
     uint64_t shadow_rays = 0;      // explicit visibility samples traced into the map
-    uint64_t occupied_voxels = 0;  // voxels holding pre-pass surface points
+    uint64_t occupied_voxels = 0;  // voxels holding pre-pass points (on surfaces or in media)
     uint64_t light_cells = 0;      // voxels holding light points plus direction bins holding directions
     uint64_t seeded_pairs = 0;     // pairs that received at least one sample
 };

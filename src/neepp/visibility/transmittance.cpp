@@ -11,12 +11,15 @@ namespace neepp {
 namespace {
 
 // A segment's transmittance per channel: exactly for a homogeneous medium; else ratio tracking, free
-// flights drawn in `channel` against the majorant, each tentative collision weighted by sigma_n / majorant.
-Color segment_transmittance(const Medium &medium, const Ray &ray, float t_end, int channel, Sampler &sampler) {
+// flights drawn in `channel` against the majorant, each tentative collision weighted by sigma_n / majorant
+// (one density lookup each, counted in counters.transmittance_lookups).
+Color segment_transmittance(const Medium &medium, const Ray &ray, float t_end, int channel, Sampler &sampler,
+                            RenderCounters &counters, bool &crossed) {
     Ray r = ray;
     r.tmax = std::min(ray.tmax, t_end);
     float t0, t1;
     if (!medium.overlap(r, t0, t1)) return Color(1.f);
+    crossed = true;
     if (medium.homogeneous()) return vexp(-medium.majorant() * (t1 - t0));
     const Color majorant = medium.majorant();
     const float m = majorant[channel];
@@ -31,6 +34,7 @@ Color segment_transmittance(const Medium &medium, const Ray &ray, float t_end, i
             return T * vexp(-(majorant - Color(m)) * rest);
         }
         // A tentative collision, drawn with density m e^{-m step}: the ratio of its weight in each channel.
+        ++counters.transmittance_lookups;
         T *= vexp(-(majorant - Color(m)) * step) * ((majorant - medium.at(r.at(next)).sigma_t) / m);
         if (!(max_component(T) > 0)) return Color(0.f);
         t = next;
@@ -47,13 +51,14 @@ Color trace_transmittance(const Scene &scene, const Ray &ray, const Medium *medi
     const Vec3 target = bounded ? ray.at(ray.tmax) : Vec3(0.f);
     Color T(1.f);
     Ray r = ray;
+    bool crossed_medium = false;
     // Each surface crossed is one more query; a ray that would cross more than this many has let through
     // nothing worth the time (a stack of thin sheets).
     constexpr int kMaxCrossings = 256;
     for (int crossing = 0;; ++crossing) {
         SurfaceInteraction si;
         const bool hit = crossing < kMaxCrossings && scene.intersect(r, si);
-        if (medium) T *= segment_transmittance(*medium, r, hit ? si.t : r.tmax, channel, sampler);
+        if (medium) T *= segment_transmittance(*medium, r, hit ? si.t : r.tmax, channel, sampler, counters, crossed_medium);
         if (!hit || crossing >= kMaxCrossings) {
             if (crossing >= kMaxCrossings) T = Color(0.f);
             break;
@@ -68,6 +73,7 @@ Color trace_transmittance(const Scene &scene, const Ray &ray, const Medium *medi
     }
     counters.occlusion_ticks += read_ticks() - start;
     counters.shadow_rays_occluded += !(max_component(T) > 0);
+    counters.medium_shadow_rays += crossed_medium;
     return T;
 }
 
