@@ -211,13 +211,15 @@ std::unique_ptr<Integrator> make_integrator(const std::string &name, const Optio
             throw std::invalid_argument("pssmlt: light_paths=neepp is refused: its pool of light subpaths is traced anew "
                                         "every pass, so a sample would not be a function of the chain's numbers");
         const std::string over = o.bidirectional ? "bdpt" : "path";
-        std::unique_ptr<Integrator> inner;
+        std::unique_ptr<Integrator> inner, volumetric;
         try {
             inner = make_integrator(over, options);
+            // Over the path tracer, scenes with media run the chains over its volumetric form.
+            if (!o.bidirectional) volumetric = make_integrator("volpath", options);
         } catch (const std::invalid_argument &e) {
             throw std::invalid_argument("pssmlt (over " + over + "): " + e.what());
         }
-        integrator = std::make_unique<PSSMLTIntegrator>(o, std::move(inner));
+        integrator = std::make_unique<PSSMLTIntegrator>(o, std::move(inner), std::move(volumetric));
     } else if (const IntegratorPlugin *make = find_registered(name)) {
         integrator = (*make)(options);
         if (!integrator) throw std::invalid_argument("the registered integrator '" + name + "' made nothing");

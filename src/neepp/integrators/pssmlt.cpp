@@ -43,16 +43,28 @@ void record(SplatFilm &film, const std::vector<PSSMLTIntegrator::Contribution> &
 
 }  // namespace
 
-PSSMLTIntegrator::PSSMLTIntegrator(PSSMLTOptions options, std::unique_ptr<Integrator> inner)
-    : options_(options), inner_(std::move(inner)), inner_rays_(dynamic_cast<const RayIntegrator *>(inner_.get())),
-      inner_splats_(dynamic_cast<const SplattingIntegrator *>(inner_.get())) {
+PSSMLTIntegrator::PSSMLTIntegrator(PSSMLTOptions options, std::unique_ptr<Integrator> inner,
+                                   std::unique_ptr<Integrator> volumetric)
+    : options_(options), plain_(std::move(inner)), volumetric_(std::move(volumetric)) {
+    use_inner(plain_.get());
+    if (volumetric_) {
+        use_inner(volumetric_.get());
+        use_inner(plain_.get());
+    }
+}
+
+void PSSMLTIntegrator::use_inner(Integrator *inner) {
+    inner_ = inner;
+    inner_rays_ = dynamic_cast<const RayIntegrator *>(inner);
+    inner_splats_ = dynamic_cast<const SplattingIntegrator *>(inner);
     if (!inner_rays_ && !inner_splats_) throw std::invalid_argument("pssmlt: the inner integrator must render per sample");
 }
 
 void PSSMLTIntegrator::prepare(const Scene &scene) {
-    if (scene.has_media())
-        throw std::invalid_argument("pssmlt: participating media are not supported by its chains yet; render this "
-                                    "scene with the volpath integrator");
+    if (scene.has_media() && !volumetric_)
+        throw std::invalid_argument("pssmlt: participating media are not supported by its bidirectional chains; "
+                                    "render this scene with pssmlt over volpath (bidirectional=false) or with volpath");
+    use_inner(scene.has_media() ? volumetric_.get() : plain_.get());
     inner_->prepare(scene);
     chains_.clear();
     bootstrapped_ = map_changed_ = false;

@@ -38,7 +38,10 @@ struct PSSMLTOptions {
 
 class PSSMLTIntegrator final : public PassIntegrator {
 public:
-    PSSMLTIntegrator(PSSMLTOptions options, std::unique_ptr<Integrator> inner);
+    // volumetric: what the chains run over in scenes with participating media (volpath where inner is
+    // path), or null where inner has no such form (bdpt): such scenes are then refused.
+    PSSMLTIntegrator(PSSMLTOptions options, std::unique_ptr<Integrator> inner,
+                     std::unique_ptr<Integrator> volumetric = nullptr);
     void prepare(const Scene &scene) override;
     uint64_t render_pass(const Scene &scene, const PassInfo &pass, SplatFilm &splats, RenderCounters &counters,
                          const PassControl &control) override;
@@ -76,10 +79,12 @@ private:
     std::string encode_chains() const;
 
     PSSMLTOptions options_;
-    std::unique_ptr<Integrator> inner_;
+    std::unique_ptr<Integrator> plain_, volumetric_;
+    Integrator *inner_;  // the one of the two the scene prepared for needs
     // inner_ as its family: one of the two is set (read once here, not at every sample).
-    const RayIntegrator *inner_rays_;
-    const SplattingIntegrator *inner_splats_;
+    const RayIntegrator *inner_rays_ = nullptr;
+    const SplattingIntegrator *inner_splats_ = nullptr;
+    void use_inner(Integrator *inner);
     std::vector<Chain> chains_;
     // The chains as the pass under way found them: a pass cut short is not in a checkpoint (the render
     // loop keeps whole passes), so neither are its mutations.
