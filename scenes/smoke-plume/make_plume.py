@@ -94,6 +94,10 @@ def plume(res=RES, seed: int = SEED) -> np.ndarray:
     # Fade to zero at the faces (the grid is clamped outside the box: this keeps the box invisible).
     edge = lambda t: np.clip(np.minimum(t, 1.0 - t) / 0.06, 0.0, 1.0)  # noqa: E731
     density *= edge(x) * edge(z) * np.clip((1.0 - y) / 0.15, 0.0, 1.0)
+    # ... and exactly zero on the outer layer of voxels (the side faces, the top and the bottom).
+    density[:, :, [0, -1]] = 0.0
+    density[[0, -1]] = 0.0
+    density[:, [0, -1]] = 0.0
     density /= density.max()
     return density.astype(np.float32)
 
