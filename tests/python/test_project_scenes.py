@@ -8,7 +8,9 @@ Each scene is rendered at a quarter of its default resolution with both renderer
 (estimated from the noise of neepp − Mitsuba over 8×8 tiles) plus 0.5 % (a bias that small is below
 what these spp can resolve). A scene whose environment map lives in ../shared/scenes is skipped when
 that is absent. The materials scene (every BSDF) gets its bitmap and environment map from this test,
-made procedurally, and so checks every material against Mitsuba as well.
+made procedurally, and so checks every material against Mitsuba as well. The media scenes (door-ajar-fog,
+smoke-plume, sunbeam) are rendered by both with volpath, their own integrator; smoke-plume's grid is
+generated first when missing (neepp_tools.scene_assets).
 """
 from __future__ import annotations
 
@@ -19,7 +21,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from neepp_tools import REPO_ROOT, exr, metrics, runner
+from neepp_tools import REPO_ROOT, exr, metrics, runner, scene_assets
 
 SCENES = sorted(p.parent.name for p in (REPO_ROOT / "scenes").glob("*/scene.xml"))
 SPP = 256
@@ -33,6 +35,13 @@ def _size(xml: Path) -> tuple[int, int]:
     w = int(re.search(r'<default name="resx" value="(\d+)"', text).group(1))
     h = int(re.search(r'<default name="resy" value="(\d+)"', text).group(1))
     return max(16, w // 4), max(16, h // 4)
+
+
+def _integrator(xml: Path) -> str:
+    """The scene's own integrator (its `integrator` parameter's default): Mitsuba renders the media scenes
+    with volpath, as neepp does, not with its path (which renders them as if in vacuum)."""
+    m = re.search(r'<default name="integrator" value="(\w+)"', xml.read_text())
+    return m.group(1) if m else "path"
 
 
 def _needs_missing_file(xml: Path, defines: dict) -> str | None:
@@ -68,7 +77,8 @@ def mitsuba_image(xml: Path, variant: str, defines: dict):
     if key not in _memo:
         w, h = _size(xml)
         _memo[key] = runner.run_mitsuba(xml, variant=variant, resx=w, resy=h, spp=SPP, max_depth=MAX_DEPTH,
-                                        seed=7, defines=defines, timeout=900, cache=True).image
+                                        seed=7, integrator=_integrator(xml), defines=defines, timeout=900,
+                                        cache=True).image
     return _memo[key]
 
 
@@ -80,6 +90,7 @@ SAMPLERS = ["power", "uniform", "spatial", "spatial-oriented", "bvh", "visibilit
 @pytest.mark.parametrize("scene", SCENES)
 def test_scene_matches_mitsuba(scene, light_sampler, neepp_bin, mitsuba_variant):
     xml = REPO_ROOT / "scenes" / scene / "scene.xml"
+    scene_assets.ensure_scene_assets(scene)  # smoke-plume's grid, generated when missing
     defines = _defines(scene)
     missing = _needs_missing_file(xml, defines)
     if missing:
