@@ -29,6 +29,14 @@ on a machine shared with other work): the efficiency columns use it.
     .venv/bin/python bench/bench_neepp.py --scenes office,bathroom --spp 64 --policies nee,ris-8 \
         --threads 1 --cpu-time --no-equal-time                              # resampling, equal spp only
 
+Through participating media (--scenes media: door-ajar-fog, smoke-plume, sunbeam; volpath, their default
+integrator) the visibility test is a transmittance estimate: the tables add the shadow rays that crossed
+a medium and the density lookups per sample of the shadow rays' transmittance estimates (what a skipped
+ray saves) and of the paths' free flights.
+
+    .venv/bin/python bench/bench_neepp.py --scenes media --spp 16,64 --policies nee,neepp-adaptive,auto \
+        --threads 1 --cpu-time --no-equal-time
+
 Writes bench/out/neepp/ (git-ignored): report.md, results.json, per-scene images and error maps.
 """
 from __future__ import annotations
@@ -41,7 +49,7 @@ from pathlib import Path
 REPO = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(REPO / "python"))
 
-from neepp_tools import REFERENCES, SCENES_DIR, credit, exr, machine, metrics, report, runner  # noqa: E402
+from neepp_tools import REFERENCES, SCENES_DIR, credit, exr, machine, metrics, report, runner, scene_assets  # noqa: E402
 
 POLICIES = ["nee", "neepp", "neepp-adaptive", "neepp-cv", "env-visibility", "auto"]
 # Configurations beyond a shadow-ray policy's name (any other name is passed as shadow_rays=NAME): NEE++'s
@@ -57,6 +65,8 @@ CONFIGS = {
 for _m in (2, 4, 8, 16):
     CONFIGS[f"ris-{_m}"] = {"ris": _m}
 PROJECT_SCENES = REPO / "scenes"
+# The project's scenes with participating media (rendered with volpath, their default): --scenes media.
+MEDIA_SCENES = ["door-ajar-fog", "smoke-plume", "sunbeam"]
 
 
 def config_options(policy: str) -> dict:
@@ -89,6 +99,13 @@ def row_for(policy, r, ref, base):
     row = {"policy": policy, "spp": s["spp"], "relMSE": rel, "shadow_rays": s["shadow_rays"],
            "occlusion_s": s["occlusion_time_s"], "render_s": s["render_time_s"],
            "cpu_s": s.get("render_cpu_time_s", float("nan"))}
+    if s.get("medium_shadow_rays", 0):
+        # Through media the visibility test is a transmittance estimate (occlusion_s is its time): the
+        # density lookups it makes per sample are what a skipped shadow ray saves.
+        samples = max(1, s["spp"] * s["width"] * s["height"])
+        row["medium_shadow_rays"] = s["medium_shadow_rays"]
+        row["tr lookups/sample"] = s.get("transmittance_lookups", 0) / samples
+        row["path lookups/sample"] = s.get("density_lookups", 0) / samples
     if base is not None:
         row["relMSE ratio"] = rel / base["relMSE"]
         row["shadow ray ratio"] = s["shadow_rays"] / max(1, base["shadow_rays"])
@@ -179,8 +196,10 @@ def main(argv=None) -> int:
         TIME["column"] = "cpu_s"
     out = Path(a.out)
     out.mkdir(parents=True, exist_ok=True)
-    results, md = {}, ["# NEE++ vs NEE (path integrator, max_depth %d)\n\nmachine: %s\n" % (a.max_depth, machine.summary())]
-    for scene in a.scenes.split(","):
+    results, md = {}, ["# NEE++ vs NEE (each scene's path or volpath integrator, max_depth %d)\n\nmachine: %s\n"
+                       % (a.max_depth, machine.summary())]
+    scenes = [n for name in a.scenes.split(",") for n in (MEDIA_SCENES if name == "media" else [name])]
+    for scene in scenes:
         if scene in REFERENCES:
             W, H, _, ref_name = REFERENCES[scene]
             w, h = W // a.scale, H // a.scale
@@ -192,6 +211,7 @@ def main(argv=None) -> int:
             xml = PROJECT_SCENES / scene / "scene.xml"
             if not xml.exists():
                 ap.error(f"unknown scene {scene!r}: neither a Bitterli scene ({', '.join(REFERENCES)}) nor {xml}")
+            scene_assets.ensure_scene_assets(scene)  # generated files (the smoke plume's density grid)
             ref = own_reference(xml, out / scene, w, h, a)
             about_ref = f"neepp nee, {a.ref_spp} spp"
         md.append(f"\n## {scene} ({w}x{h}, box filter; reference: {about_ref}; time: {TIME['column']})\n")

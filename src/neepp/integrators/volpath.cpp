@@ -11,6 +11,7 @@
 // of the densities each channel would have given it (Mitsuba's volpathmis, one-sample MIS over channels).
 #include <algorithm>
 #include <cmath>
+#include <optional>
 
 #include "neepp/base/bsdf.h"
 #include "neepp/base/medium.h"
@@ -87,14 +88,24 @@ Color PathIntegrator::Li_volumetric(const Scene &scene, const Ray &camera_ray, S
     SurfaceInteraction si;
     bool hit = false, need_hit = true;
     for (;;) {
+        // In a homogeneous medium where the path collides does not depend on what lies beyond: the distance
+        // is drawn first and surfaces are looked for only up to it (as Mitsuba does). In a dense medium most
+        // rays then end before any surface, and a short query that finds nothing is cheap.
+        std::optional<FreeFlight> drawn_first;
         if (need_hit) {
-            hit = scene.intersect(ray, si);
+            Ray query = ray;
+            if (medium && medium->homogeneous()) {
+                drawn_first = sample_free_flight(*medium, ray, ray.tmax, channel, sampler);
+                if (drawn_first->event != FreeFlight::Passed) query.tmax = drawn_first->t;
+            }
+            hit = scene.intersect(query, si);
             ++counters.rays;
             need_hit = false;
         }
         // In a medium: a collision before the surface ahead, or none.
         if (medium) {
-            const FreeFlight flight = sample_free_flight(*medium, ray, hit ? si.t : ray.tmax, channel, sampler);
+            FreeFlight flight = drawn_first ? *drawn_first : sample_free_flight(*medium, ray, hit ? si.t : ray.tmax, channel, sampler);
+            if (drawn_first && hit) flight = passed_free_flight(*medium, ray, si.t);  // the surface came first
             counters.density_lookups += flight.event != FreeFlight::Passed;
             const Color p = pdf_ratio * flight.pdf;
             const float mean = (p.x + p.y + p.z) / 3.f;

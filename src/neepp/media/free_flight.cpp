@@ -16,10 +16,7 @@ FreeFlight sample_free_flight(const Medium &medium, const Ray &ray, float t_end,
     const Color majorant = medium.majorant();
     const float m = majorant[channel];
     const float t = m > 0 ? t0 - std::log(1.f - sampler.next_1d()) / m : kInfinity;
-    if (!(t < t1)) {  // through to the end: no collision, in each channel with probability e^{-majorant d}
-        f.f = f.pdf = vexp(-majorant * (t1 - t0));
-        return f;
-    }
+    if (!(t < t1)) return passed_free_flight(medium, ray, t_end);
     f.t = t;
     const Color tr = vexp(-majorant * (t - t0));
     const MediumCoefficients c = medium.at(r.at(t));
@@ -31,6 +28,15 @@ FreeFlight sample_free_flight(const Medium &medium, const Ray &ray, float t_end,
     f.event = null ? FreeFlight::Null : FreeFlight::Real;
     f.f = tr * (null ? sigma_n : c.sigma_s);
     f.pdf = tr * majorant * (null ? p_null : 1.f - p_null);
+    return f;
+}
+
+FreeFlight passed_free_flight(const Medium &medium, const Ray &ray, float t_end) {
+    FreeFlight f;
+    Ray r = ray;
+    r.tmax = std::min(ray.tmax, t_end);
+    float t0, t1;
+    if (medium.overlap(r, t0, t1)) f.f = f.pdf = vexp(-medium.majorant() * (t1 - t0));
     return f;
 }
 

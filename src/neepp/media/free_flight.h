@@ -24,4 +24,8 @@ struct FreeFlight {
 // once; Passed looks nothing up.
 FreeFlight sample_free_flight(const Medium &medium, const Ray &ray, float t_end, int channel, Sampler &sampler);
 
+// The flight that passed through to t_end without a collision: its weight and density, e^{-majorant d}
+// per channel over the part of the ray the medium overlaps.
+FreeFlight passed_free_flight(const Medium &medium, const Ray &ray, float t_end);
+
 }  // namespace neepp
