@@ -58,12 +58,20 @@ Color trace_transmittance(const Scene &scene, const Ray &ray, const Medium *medi
     for (int crossing = 0;; ++crossing) {
         SurfaceInteraction si;
         const bool hit = crossing < kMaxCrossings && scene.intersect(r, si);
-        if (medium) T *= segment_transmittance(*medium, r, hit ? si.t : r.tmax, channel, sampler, counters, crossed_medium);
-        if (!hit || crossing >= kMaxCrossings) {
-            if (crossing >= kMaxCrossings) T = Color(0.f);
+        if (crossing >= kMaxCrossings) {
+            T = Color(0.f);
             break;
         }
-        T *= si.shape->bsdf->null_transmission(si, si.wi);
+        // What the surface ahead lets through, first: behind a wall the segment's transmittance does not
+        // matter, and not estimating it saves a ratio-tracking walk through the medium before the wall.
+        const Color through = hit ? si.shape->bsdf->null_transmission(si, si.wi) : Color(1.f);
+        if (!(max_component(through) > 0)) {
+            T = Color(0.f);
+            break;
+        }
+        if (medium) T *= segment_transmittance(*medium, r, hit ? si.t : r.tmax, channel, sampler, counters, crossed_medium);
+        if (!hit) break;
+        T *= through;
         if (!(max_component(T) > 0)) break;
         if (si.shape->is_medium_transition()) medium = si.shape->medium_toward(r.d, si.n);
         // On past the surface, toward the same point.
