@@ -40,10 +40,16 @@ std::shared_ptr<const Volume> make_volume(const XmlNode &node) {
     node.get_string("accel", "");  // Mitsuba's GPU texture option
     if (!node.has("filename")) throw node.error("a gridvolume needs a 'filename': its grid as a .vol file");
     const std::string path = node.resolve_path(node.get_string("filename"));
-    try {  // the file's own error, located at the volume using it
-        return std::make_shared<GridVolume>(read_volume_grid(path), o);
+    try {  // the file's own error, located at the volume using it and naming its use
+        VolumeGrid grid = read_volume_grid(path);  // its errors name the file
+        if (!grid.warning.empty()) warn(node.file, node.line, path + ": " + grid.warning);
+        try {
+            return std::make_shared<GridVolume>(std::move(grid), o);
+        } catch (const std::invalid_argument &e) {
+            throw SceneError(path, e.what());
+        }
     } catch (const std::exception &e) {
-        throw node.error(e.what());
+        throw node.error((node.name.empty() ? "" : "as \"" + node.name + "\": ") + e.what());
     }
 }
 
@@ -169,6 +175,11 @@ const Medium *Factories::medium(const XmlNode &node, bool used) {
     } else {
         m = std::make_shared<HeterogeneousMedium>(sigma_t, albedo, scale);
     }
+    // Each is a float, their product need not be: an infinite extinction would make every free flight 0
+    // long and every transmittance NaN.
+    if (const Color bound = m->majorant(); !std::isfinite(bound.x) || !std::isfinite(bound.y) || !std::isfinite(bound.z))
+        throw node.error("sigma_t times scale is not a finite number (the largest sigma_t " +
+                         std::to_string(sigma_t->max()) + ", scale " + std::to_string(scale) + ")");
     m->phase = phase ? phase : std::make_shared<IsotropicPhase>();
     m->sample_emitters = node.get_bool("sample_emitters", true);
     warn_unused(node);
