@@ -550,6 +550,8 @@ TEST(SceneErrors, PhaseFunctionsLoadAndTheirMistakesNameTheirLine) {
          "unsupported phase function 'sggxx'"},
         {R"(<phase type="blendphase"><phase type="isotropic"/><phase type="isotropic"/><texture name="weight" type="checkerboard"/></phase>)",
          "not a <texture>"},
+        {R"(<phase type="blendphase"><phase type="isotropic"/><phase type="isotropic"/><volume name="weights" type="constvolume"/></phase>)",
+         "a blendphase's volume is its \"weight\", not \"weights\""},
     };
     for (const auto &[phase, needle] : mistakes) {
         const std::string msg = load_error(in_medium(phase));

@@ -99,7 +99,10 @@ std::shared_ptr<const PhaseFunction> make_phase(const XmlNode &node) {
                 if (nested.size() == 2) throw child.error("a blendphase blends two phase functions (this is a third)");
                 nested.push_back(located_at(child, [&] { return make_phase(child); }));
                 warn_unused(child);
-            } else if (!(child.tag == "volume" && node.child_names[i] == "weight")) {
+            } else if (child.tag == "volume") {
+                if (node.child_names[i] != "weight")
+                    throw child.error("a blendphase's volume is its \"weight\", not \"" + node.child_names[i] + "\"");
+            } else {
                 throw child.error("a blendphase holds two <phase> and a 'weight' (a <float> or a <volume>), not a <" +
                                   child.tag + ">");
             }

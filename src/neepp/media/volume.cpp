@@ -25,7 +25,8 @@ GridVolume::GridVolume(VolumeGrid grid, const GridVolumeOptions &options) : grid
             "the value at grid point (" + std::to_string(point % grid_.size[0]) + ", " +
             std::to_string(point / grid_.size[0] % grid_.size[1]) + ", " + std::to_string(point / grid_.size[0] / grid_.size[1]) +
             ")" + (grid_.channels > 1 ? ", channel " + std::to_string(i % grid_.channels) + "," : "") + " is " +
-            std::to_string(v) + (std::isfinite(v) ? ": a gridvolume's values (densities, albedos, weights) are not negative" : ": not a finite number"));
+            std::to_string(v) +
+            (std::isfinite(v) ? ": a gridvolume's values (densities, albedos, weights) are not negative" : ": not a finite number"));
     }
     const float data_max = *std::max_element(grid_.values.begin(), grid_.values.end());
     // max() bounds the data: a heterogeneous medium draws its free flights against it, and a bound below
