@@ -120,6 +120,44 @@ TEST(VolPath, SingleScatteringOfALitSlab) {
     expect_mean(none.image, Color(0.f), "max_depth 1");
 }
 
+// The same slab with the phase functions that have no parameter to show their sign: each one's backward
+// value (cos_theta = -1 to the direction of travel, wo = wi) is what the camera sees. A tabphase's first
+// value is the backward one; a blendphase reads its weight at the scattering point, here a grid that is 0
+// (the first alone) over x < 0.5, three quarters of the image, and 1 (the second alone) beyond.
+TEST(VolPath, SingleScatteringShowsEachPhaseFunctionsBackwardValue) {
+    const float h = 0.6f, E = 3.f;
+    const Color sigma_t(0.8f, 2.f, 4.f), albedo(0.9f, 0.5f, 0.7f);
+    VolumeGridFile split;
+    split.size[0] = 2, split.size[1] = 1, split.size[2] = 1;
+    split.values = {0.f, 1.f};
+    const std::string dir = std::filesystem::path(write_temp_scene("", "split.vol")).parent_path().string();
+    {
+        std::ofstream(dir + "/split.vol", std::ios::binary) << volume_grid_bytes(split);
+    }
+    const float g = 0.4f, hg_backward = (1 - g * g) / (4 * kPi * std::pow(1 + g, 3.f)), rayleigh_backward = 3.f / (8.f * kPi);
+    const std::vector<std::pair<std::string, float>> phases = {
+        {R"(<phase type="rayleigh"/>)", rayleigh_backward},
+        // 1 at cos_theta = -1, 0.5 at 0, 0.25 at 1: mass 1.125 over the cosine, 1/(2 pi) per unit of azimuth.
+        {R"(<phase type="tabphase"><string name="values" value="1, 0.5, 0.25"/></phase>)", 1.f / 1.125f * kInv2Pi},
+        {fmt::format(R"(<phase type="blendphase"><phase type="hg"><float name="g" value="{g}"/></phase><phase type="rayleigh"/>
+             <volume name="weight" type="gridvolume"><string name="filename" value="{dir}/split.vol"/><string name="filter_type" value="nearest"/>
+               <transform name="to_world"><scale x="2"/><translate x="-0.5"/></transform></volume></phase>)",
+                     fmt::arg("g", g), fmt::arg("dir", dir)),
+         0.75f * hg_backward + 0.25f * rayleigh_backward},
+    };
+    const std::string light = fmt::format(
+        R"(<emitter type="directional"><vector name="direction" value="0,0,-1"/><rgb name="irradiance" value="{}"/></emitter>)", E);
+    for (const auto &[phase, backward] : phases) {
+        const std::string medium =
+            R"(<rgb name="sigma_t" value="0.2, 0.5, 1"/><float name="scale" value="4"/><rgb name="albedo" value="0.9, 0.5, 0.7"/>)" + phase;
+        Color expected;
+        for (int c = 0; c < 3; ++c)
+            expected[c] = albedo[c] * sigma_t[c] * backward * E * (1 - std::exp(-2 * sigma_t[c] * h)) / (2 * sigma_t[c]);
+        const auto out = render_scene_file(write_temp_scene(slab_xml(h, medium, light, 2)), 512, 5, Options(), "volpath");
+        expect_mean(out.image, expected, phase);
+    }
+}
+
 // An albedo-1 medium neither adds nor removes light: in a uniform sky every pixel is the sky, whatever
 // the estimator (NEE or not, every shadow-ray policy, a light choice that reads the map).
 TEST(VolPath, MediumFurnaceIsTheSky) {

@@ -54,9 +54,30 @@ TEST(VolumeGridReader, ReadsSizesChannelsBoundsAndValuesInMitsubasOrder) {
     EXPECT_EQ(g.at(2, 1, 3), 312.f);
     EXPECT_EQ(g.at(2, 1, 3, 1), -312.f);
     EXPECT_EQ(g.at(1, 0, 2), 201.f);
-    // Bytes after the values are ignored, as Mitsuba ignores them.
+    EXPECT_EQ(g.warning, "");
+    // Bytes after the values are ignored, as Mitsuba ignores them, and said (the loader warns).
     const VolumeGrid longer = read_volume_grid(tmp.write("longer.vol", volume_grid_bytes(two_channel_grid()) + "tail"));
     EXPECT_EQ(longer.values, g.values);
+    EXPECT_NE(longer.warning.find("4 bytes after the 3 x 2 x 4 points of 2 channels"), std::string::npos) << longer.warning;
+}
+
+// A header that gives fewer values than the file holds: Mitsuba reads the first ones, so neepp does, but
+// a data size that is a whole multiple of the header's says which mistake it likely is.
+TEST(VolumeGridReader, DataBeyondTheHeadersShapeIsSaid) {
+    TempDir tmp;
+    VolumeGridFile g = two_channel_grid();
+    g.channels = 1;  // the data has two per point
+    const VolumeGrid one = read_volume_grid(tmp.write("one.vol", volume_grid_bytes(g)));
+    EXPECT_EQ(one.values.size(), 24u);
+    EXPECT_NE(one.warning.find("96 bytes after the 3 x 2 x 4 points of 1 channel that the header gives"), std::string::npos)
+        << one.warning;
+    EXPECT_NE(one.warning.find("exactly 2 times as many values: is the size or the channel count wrong?"), std::string::npos)
+        << one.warning;
+    g = two_channel_grid();
+    g.size[2] = 3;  // 48 values written, 36 read: not a multiple
+    const VolumeGrid short_z = read_volume_grid(tmp.write("short_z.vol", volume_grid_bytes(g)));
+    EXPECT_NE(short_z.warning.find("48 bytes after"), std::string::npos) << short_z.warning;
+    EXPECT_EQ(short_z.warning.find("times as many"), std::string::npos) << short_z.warning;
 }
 
 TEST(VolumeGridReader, BadFilesAreRefusedNamingTheFile) {

@@ -217,7 +217,15 @@ std::map<std::string, std::map<std::string, PluginCase>> plugin_cases() {
          {{"isotropic", {R"(<shape type="sphere"><bsdf type="null"/><medium type="homogeneous" name="interior"><phase type="isotropic">@</phase></medium></shape>)",
                          {}}},
           {"hg", {R"(<shape type="sphere"><bsdf type="null"/><medium type="homogeneous" name="interior"><phase type="hg">@</phase></medium></shape>)",
-                  {{"g", "float", Negative::Accepted, "-0.5"}}}}}},
+                  {{"g", "float", Negative::Accepted, "-0.5"}}}},
+          {"rayleigh", {R"(<shape type="sphere"><bsdf type="null"/><medium type="homogeneous" name="interior"><phase type="rayleigh">@</phase></medium></shape>)",
+                        {}}},
+          // Mitsuba clips the weight to [0, 1] where it reads it, so any finite number is accepted.
+          {"blendphase", {R"(<shape type="sphere"><bsdf type="null"/><medium type="homogeneous" name="interior"><phase type="blendphase"><phase type="isotropic"/><phase type="hg"/>@</phase></medium></shape>)",
+                          {accepted("weight", "float")}, R"(<float name="weight" value="0.5"/>)"}},
+          // Its numbers are in a string; each is checked as a <float> would be, and a density is not negative.
+          {"tabphase", {R"(<shape type="sphere"><bsdf type="null"/><medium type="homogeneous" name="interior"><phase type="tabphase">@</phase></medium></shape>)",
+                        {refused("values", "string")}, R"(<string name="values" value="1, 2"/>)"}}}},
         {"film",
          {{"hdrfilm", {sensor("perspective", "<film type=\"hdrfilm\">@</film>"),
                        {refused("width", "integer"), refused("height", "integer"), refused("crop_offset_x", "integer"),

@@ -7,6 +7,9 @@
 #include "neepp/materials/normalmap.h"
 #include "neepp/materials/principled.h"
 #include "neepp/materials/principledthin.h"
+#include "neepp/media/blend_phase.h"
+#include "neepp/media/phase_functions.h"
+#include "neepp/media/tabulated_phase.h"
 #include "test_scenes.h"
 
 using namespace neepp;
@@ -319,7 +322,7 @@ TEST(SceneCheck, ListsEveryProblemAtOnce) {
         "  <bsdf type=\"glitter\"/>\n"                                                        // 7
         "</shape>\n"                                                                          // 8
         "<shape type=\"teapot\"/>\n"                                                          // 9
-        "<medium type=\"homogeneous\" id=\"fog\"><phase type=\"rayleigh\"/></medium>\n");    // 10
+        "<medium type=\"homogeneous\" id=\"fog\"><phase type=\"fogbow\"/></medium>\n");      // 10
     const std::string path = write_temp_scene(xml, "many_problems.xml");
     const std::vector<SceneProblem> problems = check_scene(path);
     std::vector<std::pair<int, bool>> where;
@@ -332,7 +335,7 @@ TEST(SceneCheck, ListsEveryProblemAtOnce) {
     EXPECT_EQ(where, expected);
     EXPECT_NE(problems[1].problem.find("no-such-mesh.obj"), std::string::npos);
     EXPECT_NE(problems[3].problem.find("radiuss"), std::string::npos);
-    EXPECT_NE(problems[5].problem.find("unsupported phase function 'rayleigh'"), std::string::npos);
+    EXPECT_NE(problems[5].problem.find("unsupported phase function 'fogbow'"), std::string::npos);
     EXPECT_NE(problems[6].problem.find("no light source"), std::string::npos);
     EXPECT_EQ(problems[0].text().rfind(path + ":3: error: ", 0), 0u) << problems[0].text();
     EXPECT_NE(load_error(xml, "many_problems.xml").find("many_problems.xml:4:"), std::string::npos);  // render: the first
@@ -505,4 +508,54 @@ TEST(SceneErrors, MediaMistakesNameTheirLine) {
     ASSERT_NE(scene->shapes()[0]->interior, nullptr);
     EXPECT_NE(scene->shapes()[0]->interior, scene->shapes()[0]->exterior);
     EXPECT_EQ(scene->shapes()[0]->interior->majorant(), Color(2.f));
+}
+
+// rayleigh, tabphase and blendphase: what loads (a blend's nested phase functions in order, its weight a
+// number or a volume), and each mistake an error at its line that says what was expected.
+TEST(SceneErrors, PhaseFunctionsLoadAndTheirMistakesNameTheirLine) {
+    auto in_medium = [](const std::string &phase) {
+        return scene_with("<shape type=\"sphere\"><bsdf type=\"null\"/><medium type=\"homogeneous\" name=\"interior\">\n" + phase +
+                          "\n</medium></shape>\n" + kLight);
+    };
+    auto phase_of = [&](const std::string &phase) { return load_scene(write_temp_scene(in_medium(phase)))->shapes()[0]->interior->phase; };
+    EXPECT_TRUE(std::dynamic_pointer_cast<const RayleighPhase>(phase_of(R"(<phase type="rayleigh"/>)")));
+    const auto tab = std::dynamic_pointer_cast<const TabulatedPhase>(phase_of(R"(<phase type="tabphase"><string name="values" value="1, 3"/></phase>)"));
+    ASSERT_TRUE(tab);
+    const Vec3 wi(0, 0, 1);
+    EXPECT_FLOAT_EQ(tab->eval(Vec3(0.f), wi, -wi), 3.f / 4.f * kInv2Pi);  // the last value is forward
+    const auto blend = std::dynamic_pointer_cast<const BlendPhase>(phase_of(
+        R"(<phase type="blendphase"><float name="weight" value="0.25"/><phase type="isotropic"/><phase type="rayleigh"/></phase>)"));
+    ASSERT_TRUE(blend);
+    EXPECT_FLOAT_EQ(blend->weight(Vec3(0.f)), 0.25f);
+    // w = 0.25 of rayleigh's 3/(8 pi) straight back, 0.75 of the isotropic 1/(4 pi).
+    EXPECT_NEAR(blend->eval(Vec3(0.f), wi, wi), 0.75f * kInv4Pi + 0.25f * 3.f / (8.f * kPi), 1e-6f);
+    const auto volume_weight = std::dynamic_pointer_cast<const BlendPhase>(phase_of(
+        R"(<phase type="blendphase"><phase type="isotropic"/><phase type="rayleigh"/><volume name="weight" type="constvolume"><float name="value" value="0.5"/></volume></phase>)"));
+    ASSERT_TRUE(volume_weight);
+    EXPECT_FLOAT_EQ(volume_weight->weight(Vec3(0.3f)), 0.5f);
+
+    // The phase function is on the scene's line 4.
+    const std::vector<std::pair<std::string, std::string>> mistakes = {
+        {R"(<phase type="tabphase"/>)", "needs its 'values'"},
+        {R"(<phase type="tabphase"><string name="values" value="1"/></phase>)", "at least two numbers"},
+        {R"(<phase type="tabphase"><string name="values" value="0, 0, 0"/></phase>)", "all zero"},
+        {R"(<phase type="tabphase"><string name="values" value="1, -2"/></phase>)", "\"-2\" is negative"},
+        {R"(<phase type="tabphase"><string name="values" value="1, inf"/></phase>)", "\"inf\" is not a finite number"},
+        {R"(<phase type="tabphase"><string name="values" value="1, 2a"/></phase>)", "\"2a\" is not a number"},
+        {R"(<phase type="blendphase"><phase type="isotropic"/><float name="weight" value="0.5"/></phase>)", "two nested <phase> (found 1)"},
+        {R"(<phase type="blendphase"><phase type="isotropic"/><phase type="isotropic"/><phase type="hg"/><float name="weight" value="0.5"/></phase>)",
+         "this is a third"},
+        {R"(<phase type="blendphase"><phase type="isotropic"/><phase type="isotropic"/></phase>)", "needs its 'weight'"},
+        {R"(<phase type="blendphase"><phase type="isotropic"/><phase type="sggxx"/><float name="weight" value="0.5"/></phase>)",
+         "unsupported phase function 'sggxx'"},
+        {R"(<phase type="blendphase"><phase type="isotropic"/><phase type="isotropic"/><texture name="weight" type="checkerboard"/></phase>)",
+         "not a <texture>"},
+        {R"(<phase type="blendphase"><phase type="isotropic"/><phase type="isotropic"/><volume name="weights" type="constvolume"/></phase>)",
+         "a blendphase's volume is its \"weight\", not \"weights\""},
+    };
+    for (const auto &[phase, needle] : mistakes) {
+        const std::string msg = load_error(in_medium(phase));
+        EXPECT_NE(msg.find(".xml:4:"), std::string::npos) << phase << ": " << msg;
+        EXPECT_NE(msg.find(needle), std::string::npos) << phase << ": " << msg;
+    }
 }

@@ -127,3 +127,17 @@ TEST(SdfGridShape, MeshOptionsItLacksAreReportedUnused) {
     EXPECT_FALSE(problems[0].error);
     EXPECT_NE(problems[0].problem.find("face_normals"), std::string::npos) << problems[0].problem;
 }
+
+// A header that gives fewer values than the file holds (here a 4^3 grid written under a 4 x 4 x 2 header):
+// the shape is built from the values it gives, as Mitsuba builds it, with a warning at the shape's line.
+TEST(SdfGridShape, DataBeyondTheHeaderIsWarnedAbout) {
+    VolumeGridFile half = neepp::testing::sphere_sdf_grid(4);
+    half.size[2] = 2;
+    const auto problems = check_scene(scene_with(std::string(R"(<shape type="sdfgrid">)") + kGridFile + "</shape>", half));
+    ASSERT_EQ(problems.size(), 1u);
+    EXPECT_FALSE(problems[0].error);
+    EXPECT_EQ(problems[0].line, 9);
+    EXPECT_NE(problems[0].problem.find("grid.vol: 128 bytes after the 4 x 4 x 2 points of 1 channel"), std::string::npos)
+        << problems[0].problem;
+    EXPECT_NE(problems[0].problem.find("exactly 2 times as many values"), std::string::npos) << problems[0].problem;
+}

@@ -1,10 +1,12 @@
 """Participating media against Mitsuba 3: small scenes of the project's own with homogeneous media, rendered
 by Mitsuba 3's volpath (scalar_rgb) and by neepp's volpath. Each exercises what a medium scene can get
 wrong: a chromatic medium (the hero channel's weights), a Henyey-Greenstein phase (its sign), a medium
-bounded by a null sphere over a lit floor, a heterogeneous one from density and albedo grids, an emitter and an object inside the medium, a thin dielectric
-boundary, a camera inside a medium, a dielectric boundary whose medium samples no lights (subsurface
-scattering), and a finite max_depth (collisions counted as bounces, null crossings not). The image mean
-within 1 % plus 4 standard errors, each of 3 x 3 regions within 2 % plus 4, and every block in a z-test."""
+bounded by a null sphere over a lit floor, a heterogeneous one from density and albedo grids, an emitter
+and an object inside the medium, a thin dielectric boundary, the rayleigh, tabphase and blendphase phase
+functions (a blend's weight from a grid), a camera inside a medium, a dielectric boundary whose medium
+samples no lights (subsurface scattering), and a finite max_depth (collisions counted as bounces, null
+crossings not). The image mean within 1 % plus 4 standard errors, each of 3 x 3 regions within 2 % plus 4,
+and every block in a z-test."""
 from __future__ import annotations
 
 import pytest
@@ -85,6 +87,28 @@ SCENES = {
     <medium type="homogeneous" name="interior"><float name="sigma_t" value="4"/><rgb name="albedo" value="0.9,0.6,0.3"/>
       <boolean name="sample_emitters" value="false"/><phase type="hg"><float name="g" value="0.7"/></phase></medium></shape>
 </scene>""",
+    # The phase functions without a parameter to get backward: three null spheres over the floor, Rayleigh's,
+    # a table leaning backward (Mitsuba's orientation: the last value is forward) and a blend of a forward
+    # and a backward lobe whose weight grid rises along x through the sphere (read where light scatters).
+    "phases": f"""<scene version="3.0.0">
+  <default name="spp" value="16"/>
+  <integrator type="volpath"><integer name="max_depth" value="8"/></integrator>
+  @SENSOR@
+  {FLOOR}
+  {LAMP}
+  <emitter type="constant"><rgb name="radiance" value="0.3"/></emitter>
+  <shape type="sphere"><point name="center" x="-1" y="-0.4" z="0"/><float name="radius" value="0.5"/><bsdf type="null"/>
+    <medium type="homogeneous" name="interior"><rgb name="sigma_t" value="0.5,0.67,1"/><float name="scale" value="3"/><rgb name="albedo" value="0.9,0.8,0.95"/>
+      <phase type="rayleigh"/></medium></shape>
+  <shape type="sphere"><point name="center" x="0" y="-0.4" z="0"/><float name="radius" value="0.5"/><bsdf type="null"/>
+    <medium type="homogeneous" name="interior"><float name="sigma_t" value="3"/><rgb name="albedo" value="0.95,0.8,0.6"/>
+      <phase type="tabphase"><string name="values" value="4, 1, 0.5, 0.2, 0.8"/></phase></medium></shape>
+  <shape type="sphere"><point name="center" x="1" y="-0.4" z="0"/><float name="radius" value="0.5"/><bsdf type="null"/>
+    <medium type="homogeneous" name="interior"><float name="sigma_t" value="3"/><rgb name="albedo" value="0.7,0.9,0.9"/>
+      <phase type="blendphase"><phase type="hg"><float name="g" value="0.8"/></phase><phase type="hg"><float name="g" value="-0.6"/></phase>
+        <volume name="weight" type="gridvolume"><string name="filename" value="ramp.vol"/>
+          <transform name="to_world"><translate value="0.5,-0.9,-0.5"/></transform></volume></phase></medium></shape>
+</scene>""",
 }
 
 
@@ -101,6 +125,7 @@ def write_grids(folder):
     (folder / "blob.vol").write_bytes(vol(blob[..., None]))
     tint = np.stack([0.95 - 0.4 * x, 0.6 + 0.3 * y, 0.9 * np.ones_like(z)], axis=-1)
     (folder / "tint.vol").write_bytes(vol(tint))
+    (folder / "ramp.vol").write_bytes(vol(np.array([0.0, 1.0]).reshape(1, 1, 2, 1)))
 
 
 @pytest.mark.parametrize("name", sorted(SCENES))

@@ -23,11 +23,12 @@ struct PhaseSample {
 class PhaseFunction {
 public:
     virtual ~PhaseFunction() = default;
-    // The phase function's value for light arriving along -wi and leaving along wo (it integrates to 1
-    // over wo), and the density with which sample() draws wo.
-    virtual float eval(const Vec3 &wi, const Vec3 &wo) const = 0;
-    virtual float pdf(const Vec3 &wi, const Vec3 &wo) const = 0;
-    virtual PhaseSample sample(const Vec3 &wi, Vec2 u) const = 0;
+    // The phase function's value at the point p for light arriving along -wi and leaving along wo (it
+    // integrates to 1 over wo), and the density with which sample() draws wo. Most phase functions are the
+    // same everywhere and ignore p; a blend of two takes its weight from a volume at p.
+    virtual float eval(const Vec3 &p, const Vec3 &wi, const Vec3 &wo) const = 0;
+    virtual float pdf(const Vec3 &p, const Vec3 &wi, const Vec3 &wo) const = 0;
+    virtual PhaseSample sample(const Vec3 &p, const Vec3 &wi, Vec2 u) const = 0;
 };
 
 // The coefficients at a point: extinction sigma_t = absorption + scattering sigma_s (per unit length).

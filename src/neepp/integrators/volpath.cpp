@@ -54,8 +54,8 @@ Color PathIntegrator::sample_direct_volumetric(const Scene &scene, const Scatter
         if (si.shape->is_medium_transition()) medium = si.shape->medium_toward(ds.d, si.n);
     } else {
         const PhaseFunction &phase = *v.medium->phase;
-        f = Color(phase.eval(v.wi, ds.d));
-        scatter_pdf = phase.pdf(v.wi, ds.d);
+        f = Color(phase.eval(v.p, v.wi, ds.d));
+        scatter_pdf = phase.pdf(v.p, v.wi, ds.d);
         q.ray = Ray{v.p, ds.d, 0.f, ds.dist >= kInfinity ? kInfinity : ds.dist * (1.f - kShadowEpsilon)};
     }
     if (is_black(f)) return Color(0.f);
@@ -126,7 +126,7 @@ Color PathIntegrator::Li_volumetric(const Scene &scene, const Ray &camera_ray, S
                 v.ctx = LightSampleContext{v.p, Vec3(0.f)};
                 if (options_.nee && medium->sample_emitters)
                     L += sample_direct_volumetric(scene, v, beta, channel, sampler, counters);
-                const PhaseSample ps = medium->phase->sample(v.wi, sampler.next_2d());
+                const PhaseSample ps = medium->phase->sample(v.p, v.wi, sampler.next_2d());
                 if (!(ps.pdf > 0)) break;
                 beta *= Color(ps.weight);
                 ++depth;

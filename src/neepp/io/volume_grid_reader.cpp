@@ -15,6 +15,12 @@ static_assert(std::endian::native == std::endian::little, "the .vol reader assum
 
 constexpr size_t kHeaderBytes = 3 + 1 + 4 * 5 + 4 * 6;
 
+// "4 x 4 x 2 points of 3 channels", what the header says the data is.
+std::string shape_text(const int32_t dims[4]) {
+    return std::to_string(dims[0]) + " x " + std::to_string(dims[1]) + " x " + std::to_string(dims[2]) + " points of " +
+           std::to_string(dims[3]) + (dims[3] == 1 ? " channel" : " channels");
+}
+
 }  // namespace
 
 VolumeGrid read_volume_grid(const std::string &path) {
@@ -51,14 +57,22 @@ VolumeGrid read_volume_grid(const std::string &path) {
     size_t count = 1;
     for (int32_t d : dims) {
         if (size_t(d) > available / count)
-            throw SceneError(path, "truncated volume grid file: the header gives " + std::to_string(dims[0]) + " x " +
-                                       std::to_string(dims[1]) + " x " + std::to_string(dims[2]) + " points of " +
-                                       std::to_string(dims[3]) + " channels, more values than the file's " +
-                                       std::to_string(data.size() - kHeaderBytes) + " bytes of data hold");
+            throw SceneError(path, "truncated volume grid file: the header gives " + shape_text(dims) +
+                                       ", more values than the file's " + std::to_string(data.size() - kHeaderBytes) +
+                                       " bytes of data hold");
         count *= size_t(d);
     }
     g.values.resize(count);
     std::memcpy(g.values.data(), data.data() + kHeaderBytes, count * sizeof(float));
+    if (const size_t extra = data.size() - kHeaderBytes - count * sizeof(float); extra > 0) {
+        const size_t whole = data.size() - kHeaderBytes;
+        g.warning = std::to_string(extra) + " bytes after the " + shape_text(dims) +
+                    " that the header gives are ignored, as Mitsuba ignores them";
+        // The commonest mistake: a channel count or a size that divides the data's true shape.
+        if (whole % (count * sizeof(float)) == 0)
+            g.warning += "; the file holds exactly " + std::to_string(whole / (count * sizeof(float))) +
+                         " times as many values: is the size or the channel count wrong?";
+    }
     return g;
 }
 

@@ -1,24 +1,21 @@
 // Mitsuba 3's participating media (<medium>) and phase functions (<phase>), and the scene's hold on them.
+#include <algorithm>
+#include <cmath>
+#include <cstdlib>
+#include <limits>
 #include "neepp/loader/factories.h"
 #include "neepp/loader/problems.h"
+#include "neepp/loader/supported_plugins.h"
 #include "neepp/io/volume_grid_reader.h"
+#include "neepp/media/blend_phase.h"
 #include "neepp/media/heterogeneous_medium.h"
 #include "neepp/media/homogeneous_medium.h"
 #include "neepp/media/phase_functions.h"
+#include "neepp/media/tabulated_phase.h"
 
 namespace neepp::loader {
 
 namespace {
-
-std::shared_ptr<const PhaseFunction> make_phase(const XmlNode &node) {
-    if (node.type == "isotropic") return std::make_shared<IsotropicPhase>();
-    if (node.type == "hg") {
-        // Mitsuba's default is 0.8, not 0: clouds and fog scatter forward.
-        const float g = node.get_float("g", 0.8f, NumberRange{-1, 1, true, true});
-        return std::make_shared<HenyeyGreensteinPhase>(g);
-    }
-    throw node.error("unsupported phase function '" + node.type + "' (supported: isotropic, hg)");
-}
 
 // A <volume> (constvolume or gridvolume) as Mitsuba 3 reads it.
 std::shared_ptr<const Volume> make_volume(const XmlNode &node) {
@@ -43,11 +40,89 @@ std::shared_ptr<const Volume> make_volume(const XmlNode &node) {
     node.get_string("accel", "");  // Mitsuba's GPU texture option
     if (!node.has("filename")) throw node.error("a gridvolume needs a 'filename': its grid as a .vol file");
     const std::string path = node.resolve_path(node.get_string("filename"));
-    try {  // the file's own error, located at the volume using it
-        return std::make_shared<GridVolume>(read_volume_grid(path), o);
+    try {  // the file's own error, located at the volume using it and naming its use
+        VolumeGrid grid = read_volume_grid(path);  // its errors name the file
+        if (!grid.warning.empty()) warn(node.file, node.line, path + ": " + grid.warning);
+        try {
+            return std::make_shared<GridVolume>(std::move(grid), o);
+        } catch (const std::invalid_argument &e) {
+            throw SceneError(path, e.what());
+        }
     } catch (const std::exception &e) {
-        throw node.error(e.what());
+        throw node.error((node.name.empty() ? "" : "as \"" + node.name + "\": ") + e.what());
     }
+}
+
+// Mitsuba's `tabphase` table: numbers separated by spaces or commas.
+std::vector<float> tabulated_values(const XmlNode &node) {
+    if (!node.has("values"))
+        throw node.error("a tabphase needs its 'values': a string of numbers, the density at cosines evenly spaced "
+                         "from -1 (backward) to 1 (forward)");
+    const std::string text = node.get_string("values");
+    std::vector<float> values;
+    size_t at = 0;
+    while ((at = text.find_first_not_of(" ,\t\n\r", at)) != std::string::npos) {
+        const size_t end = text.find_first_of(" ,\t\n\r", at);
+        const std::string token = text.substr(at, end == std::string::npos ? std::string::npos : end - at);
+        at = end;
+        char *stop = nullptr;
+        const double v = std::strtod(token.c_str(), &stop);
+        if (stop != token.c_str() + token.size())
+            throw node.property_error("values", "\"" + token + "\" is not a number");
+        // As any number a scene gives: finite as a float, and a density cannot be negative.
+        if (!std::isfinite(v) || std::abs(v) > std::numeric_limits<float>::max())
+            throw node.property_error("values", "\"" + token + "\" is not a finite number");
+        if (v < 0) throw node.property_error("values", "\"" + token + "\" is negative: the values are a density");
+        values.push_back(float(v));
+    }
+    if (values.size() < 2)
+        throw node.property_error("values", "needs at least two numbers (the density at cos_theta = -1 and 1)");
+    if (std::all_of(values.begin(), values.end(), [](float v) { return v == 0.f; }))
+        throw node.property_error("values", "all zero: there is no density to normalise");
+    return values;
+}
+
+std::shared_ptr<const PhaseFunction> make_phase(const XmlNode &node) {
+    if (node.type == "isotropic") return std::make_shared<IsotropicPhase>();
+    if (node.type == "hg") {
+        // Mitsuba's default is 0.8, not 0: clouds and fog scatter forward.
+        const float g = node.get_float("g", 0.8f, NumberRange{-1, 1, true, true});
+        return std::make_shared<HenyeyGreensteinPhase>(g);
+    }
+    if (node.type == "rayleigh") return std::make_shared<RayleighPhase>();
+    if (node.type == "tabphase") return std::make_shared<TabulatedPhase>(tabulated_values(node));
+    if (node.type == "blendphase") {
+        std::vector<std::shared_ptr<const PhaseFunction>> nested;
+        for (size_t i = 0; i < node.children.size(); ++i) {
+            const XmlNode &child = *node.children[i];
+            if (child.tag == "phase") {
+                if (nested.size() == 2) throw child.error("a blendphase blends two phase functions (this is a third)");
+                nested.push_back(located_at(child, [&] { return make_phase(child); }));
+                warn_unused(child);
+            } else if (child.tag == "volume") {
+                if (node.child_names[i] != "weight")
+                    throw child.error("a blendphase's volume is its \"weight\", not \"" + node.child_names[i] + "\"");
+            } else {
+                throw child.error("a blendphase holds two <phase> and a 'weight' (a <float> or a <volume>), not a <" +
+                                  child.tag + ">");
+            }
+        }
+        if (nested.size() != 2)
+            throw node.error("a blendphase needs two nested <phase> (found " + std::to_string(nested.size()) + ")");
+        // The second's share: a number or a volume, clipped to [0, 1] where it is read, as Mitsuba clips it
+        // (so any finite number is accepted). Mitsuba has no default.
+        std::shared_ptr<const Volume> weight;
+        if (std::shared_ptr<XmlNode> child = node.child("weight")) {
+            weight = located_at(*child, [&] { return make_volume(*child); });
+            warn_unused(*child);
+        } else if (node.has("weight")) {
+            weight = std::make_shared<ConstantVolume>(Color(node.get_float("weight")));
+        } else {
+            throw node.error("a blendphase needs its 'weight' (a <float> or a <volume>): the second phase function's share");
+        }
+        return std::make_shared<BlendPhase>(nested[0], nested[1], weight);
+    }
+    throw node.error("unsupported phase function '" + node.type + "' (supported: " + supported_list("phase") + ")");
 }
 
 }  // namespace
@@ -103,6 +178,11 @@ const Medium *Factories::medium(const XmlNode &node, bool used) {
     } else {
         m = std::make_shared<HeterogeneousMedium>(sigma_t, albedo, scale);
     }
+    // Each is a float, their product need not be: an infinite extinction would make every free flight 0
+    // long and every transmittance NaN.
+    if (const Color bound = m->majorant(); !std::isfinite(bound.x) || !std::isfinite(bound.y) || !std::isfinite(bound.z))
+        throw node.error("sigma_t times scale is not a finite number (the largest sigma_t " +
+                         std::to_string(sigma_t->max()) + ", scale " + std::to_string(scale) + ")");
     m->phase = phase ? phase : std::make_shared<IsotropicPhase>();
     m->sample_emitters = node.get_bool("sample_emitters", true);
     warn_unused(node);

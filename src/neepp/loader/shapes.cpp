@@ -132,6 +132,7 @@ std::shared_ptr<const SdfGrid> load_sdf_grid(const XmlNode &node) {
     const std::string path = node.resolve_path(node.get_string("filename"));
     try {  // the file's own error, located at the shape using it
         VolumeGrid grid = read_volume_grid(path);
+        if (!grid.warning.empty()) warn(node.file, node.line, path + ": " + grid.warning);
         if (grid.channels != 1)
             throw SceneError(path, "an sdfgrid's grid has " + std::to_string(grid.channels) + " channels, expected 1");
         try {

@@ -9,10 +9,12 @@
 
 namespace neepp {
 
-float IsotropicPhase::eval(const Vec3 &, const Vec3 &) const { return kInv4Pi; }
-float IsotropicPhase::pdf(const Vec3 &, const Vec3 &) const { return kInv4Pi; }
+float IsotropicPhase::eval(const Vec3 &, const Vec3 &, const Vec3 &) const { return kInv4Pi; }
+float IsotropicPhase::pdf(const Vec3 &, const Vec3 &, const Vec3 &) const { return kInv4Pi; }
 
-PhaseSample IsotropicPhase::sample(const Vec3 &, Vec2 u) const { return {square_to_uniform_sphere(u), kInv4Pi, 1.f}; }
+PhaseSample IsotropicPhase::sample(const Vec3 &, const Vec3 &, Vec2 u) const {
+    return {square_to_uniform_sphere(u), kInv4Pi, 1.f};
+}
 
 HenyeyGreensteinPhase::HenyeyGreensteinPhase(float g) : g_(g) {
     if (!(g > -1.f && g < 1.f))
@@ -29,9 +31,9 @@ float hg(float g, float cos_theta) {
 
 }  // namespace
 
-float HenyeyGreensteinPhase::eval(const Vec3 &wi, const Vec3 &wo) const { return hg(g_, -dot(wi, wo)); }
+float HenyeyGreensteinPhase::eval(const Vec3 &, const Vec3 &wi, const Vec3 &wo) const { return hg(g_, -dot(wi, wo)); }
 
-PhaseSample HenyeyGreensteinPhase::sample(const Vec3 &wi, Vec2 u) const {
+PhaseSample HenyeyGreensteinPhase::sample(const Vec3 &, const Vec3 &wi, Vec2 u) const {
     // The inverse of the lobe's distribution of cos_theta (Mitsuba's and pbrt's), about the direction of
     // travel -wi.
     float cos_theta;
@@ -47,6 +49,26 @@ PhaseSample HenyeyGreensteinPhase::sample(const Vec3 &wi, Vec2 u) const {
     const Frame frame(-wi);
     const Vec3 wo = frame.to_world(Vec3(sin_theta * std::cos(phi), sin_theta * std::sin(phi), cos_theta));
     return {wo, hg(g_, cos_theta), 1.f};
+}
+
+namespace {
+
+float rayleigh(float cos_theta) { return 3.f / (16.f * kPi) * (1.f + cos_theta * cos_theta); }
+
+}  // namespace
+
+float RayleighPhase::eval(const Vec3 &, const Vec3 &wi, const Vec3 &wo) const { return rayleigh(dot(wi, wo)); }
+
+PhaseSample RayleighPhase::sample(const Vec3 &, const Vec3 &wi, Vec2 u) const {
+    // The distribution of cos_theta is u = (3 c + c^3 + 4) / 8, the cubic c^3 + 3 c - 4 (2u - 1) = 0, whose
+    // one real root Cardano's formula gives (as Mitsuba samples it). The lobe is symmetric, so which way
+    // about wi the cosine is measured does not matter.
+    const float z = 2.f * (2.f * u.x - 1.f), root = std::sqrt(z * z + 1.f);
+    const float cos_theta = std::clamp(std::cbrt(z + root) + std::cbrt(z - root), -1.f, 1.f);
+    const float sin_theta = std::sqrt(std::max(0.f, 1.f - cos_theta * cos_theta));
+    const float phi = 2.f * kPi * u.y;
+    const Vec3 wo = Frame(wi).to_world(Vec3(sin_theta * std::cos(phi), sin_theta * std::sin(phi), cos_theta));
+    return {wo, rayleigh(cos_theta), 1.f};
 }
 
 }  // namespace neepp

@@ -1,4 +1,5 @@
-// Mitsuba 3's phase functions `isotropic` and `hg` (Henyey-Greenstein).
+// Mitsuba 3's analytic phase functions: `isotropic`, `hg` (Henyey-Greenstein) and `rayleigh`. Each is the
+// same everywhere in its medium, so the point p of the interface is not read.
 #pragma once
 #include "neepp/base/medium.h"
 
@@ -6,9 +7,9 @@ namespace neepp {
 
 class IsotropicPhase final : public PhaseFunction {
 public:
-    float eval(const Vec3 &, const Vec3 &) const override;
-    float pdf(const Vec3 &, const Vec3 &) const override;
-    PhaseSample sample(const Vec3 &wi, Vec2 u) const override;
+    float eval(const Vec3 &, const Vec3 &, const Vec3 &) const override;
+    float pdf(const Vec3 &, const Vec3 &, const Vec3 &) const override;
+    PhaseSample sample(const Vec3 &p, const Vec3 &wi, Vec2 u) const override;
 };
 
 // Henyey and Greenstein's lobe of mean cosine g between the direction light travelled in (-wi) and wo:
@@ -17,13 +18,22 @@ class HenyeyGreensteinPhase final : public PhaseFunction {
 public:
     // Throws std::invalid_argument unless -1 < g < 1.
     explicit HenyeyGreensteinPhase(float g);
-    float eval(const Vec3 &wi, const Vec3 &wo) const override;
-    float pdf(const Vec3 &wi, const Vec3 &wo) const override { return eval(wi, wo); }
-    PhaseSample sample(const Vec3 &wi, Vec2 u) const override;
+    float eval(const Vec3 &p, const Vec3 &wi, const Vec3 &wo) const override;
+    float pdf(const Vec3 &p, const Vec3 &wi, const Vec3 &wo) const override { return eval(p, wi, wo); }
+    PhaseSample sample(const Vec3 &p, const Vec3 &wi, Vec2 u) const override;
     float g() const { return g_; }
 
 private:
     float g_;
+};
+
+// Scattering by particles much smaller than the wavelength (air): 3/(16 pi) (1 + cos^2), as much backward
+// as forward. Sampled exactly (the cubic its distribution gives has a closed-form root), weight 1.
+class RayleighPhase final : public PhaseFunction {
+public:
+    float eval(const Vec3 &p, const Vec3 &wi, const Vec3 &wo) const override;
+    float pdf(const Vec3 &p, const Vec3 &wi, const Vec3 &wo) const override { return eval(p, wi, wo); }
+    PhaseSample sample(const Vec3 &p, const Vec3 &wi, Vec2 u) const override;
 };
 
 }  // namespace neepp

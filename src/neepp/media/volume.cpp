@@ -14,18 +14,36 @@ BBox unit_cube_bounds(const Transform &to_world) {
 
 GridVolume::GridVolume(VolumeGrid grid, const GridVolumeOptions &options) : grid_(std::move(grid)), options_(options) {
     if (grid_.channels != 1 && grid_.channels != 3)
-        throw std::invalid_argument("a gridvolume has 1 or 3 channels, this grid " + std::to_string(grid_.channels));
-    for (float v : grid_.values)
-        if (!std::isfinite(v) || v < 0)
-            throw std::invalid_argument("the grid holds a value that is not a finite non-negative number (" +
-                                        std::to_string(v) + ")");
-    max_ = options.max_value > 0 ? options.max_value : *std::max_element(grid_.values.begin(), grid_.values.end());
+        throw std::invalid_argument("the grid has " + std::to_string(grid_.channels) +
+                                    " channels; a gridvolume's value is grey (1 channel) or RGB (3)");
+    // Where a bad value is, so that the file's writer can find it: x fastest, then y, then z.
+    for (size_t i = 0; i < grid_.values.size(); ++i) {
+        const float v = grid_.values[i];
+        if (std::isfinite(v) && v >= 0) continue;
+        const size_t point = i / grid_.channels;
+        throw std::invalid_argument(
+            "the value at grid point (" + std::to_string(point % grid_.size[0]) + ", " +
+            std::to_string(point / grid_.size[0] % grid_.size[1]) + ", " + std::to_string(point / grid_.size[0] / grid_.size[1]) +
+            ")" + (grid_.channels > 1 ? ", channel " + std::to_string(i % grid_.channels) + "," : "") + " is " +
+            std::to_string(v) +
+            (std::isfinite(v) ? ": a gridvolume's values (densities, albedos, weights) are not negative" : ": not a finite number"));
+    }
+    const float data_max = *std::max_element(grid_.values.begin(), grid_.values.end());
+    // max() bounds the data: a heterogeneous medium draws its free flights against it, and a bound below
+    // the data would bias every image (Mitsuba renders such a scene without a word).
+    if (options.max_value > 0 && options.max_value < data_max)
+        throw std::invalid_argument("max_value " + std::to_string(options.max_value) + " is below the grid's largest value " +
+                                    std::to_string(data_max) + ": it must bound the data");
+    max_ = options.max_value > 0 ? options.max_value : data_max;
     // to_local maps world points to the unit cube: through to_world's inverse, then, with use_grid_bbox,
     // from the file's bounds.
     Transform to_world = options.to_world;
     if (options.use_grid_bbox) {
         const Vec3 lo = grid_.bounds.lo, extent = grid_.bounds.hi - grid_.bounds.lo;
-        if (!(extent.x > 0 && extent.y > 0 && extent.z > 0)) throw std::invalid_argument("use_grid_bbox: the grid's bounds are empty");
+        const bool finite = std::isfinite(lo.x) && std::isfinite(lo.y) && std::isfinite(lo.z) && std::isfinite(extent.x) &&
+                            std::isfinite(extent.y) && std::isfinite(extent.z);
+        if (!finite || !(extent.x > 0 && extent.y > 0 && extent.z > 0))
+            throw std::invalid_argument("use_grid_bbox: the grid's stored bounds are not a finite box of some volume");
         to_world = to_world * Transform::translate(lo) * Transform::scale(extent);
     }
     to_local_ = Transform(to_world.inverse_matrix, to_world.matrix);

@@ -45,8 +45,9 @@ struct GridVolumeOptions {
 
 class GridVolume final : public Volume {
 public:
-    // Throws std::invalid_argument when the grid has other than 1 or 3 channels, or a value that is not
-    // finite or is negative.
+    // Throws std::invalid_argument, saying what is wrong and where, when the grid has other than 1 or 3
+    // channels, a value that is not finite or is negative, a max_value below its largest value, or (with
+    // use_grid_bbox) stored bounds that are not a finite box.
     GridVolume(VolumeGrid grid, const GridVolumeOptions &options);
     Color eval(const Vec3 &p) const override;
     float max() const override { return max_; }
