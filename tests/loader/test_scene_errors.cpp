@@ -341,6 +341,19 @@ TEST(SceneCheck, ListsEveryProblemAtOnce) {
     EXPECT_NE(load_error(xml, "many_problems.xml").find("many_problems.xml:4:"), std::string::npos);  // render: the first
 }
 
+// A broken element that several others refer to is listed once, at its own line.
+TEST(SceneCheck, ListsASharedBrokenElementOnce) {
+    const std::string xml = scene_with(std::string(kLight) + "\n" +  // the light is line 3
+        "<medium type=\"heterogeneous\" id=\"m\"><volume name=\"sigma_t\" type=\"gridvolume\">"
+        "<string name=\"filename\" value=\"absent.vol\"/></volume></medium>\n"                         // 4
+        "<shape type=\"cube\"><bsdf type=\"null\"/><ref id=\"m\" name=\"interior\"/></shape>\n"       // 5
+        "<shape type=\"sphere\"><bsdf type=\"null\"/><ref id=\"m\" name=\"interior\"/></shape>\n");   // 6
+    const std::vector<SceneProblem> problems = check_scene(write_temp_scene(xml, "shared.xml"));
+    ASSERT_EQ(problems.size(), 1u);
+    EXPECT_EQ(problems[0].line, 4);
+    EXPECT_NE(problems[0].problem.find("absent.vol"), std::string::npos) << problems[0].problem;
+}
+
 TEST(SceneCheck, ASoundSceneHasNoProblem) {
     const std::string path = write_temp_scene(scene_with(std::string(kLight) + "\n<shape type=\"sphere\"/>"), "sound.xml");
     EXPECT_TRUE(check_scene(path).empty());

@@ -28,7 +28,12 @@ void warn(const std::string &file, int line, const std::string &text) {
 }
 
 void record(const SceneError &e) {
-    if (t_problems) t_problems->push_back({e.file, e.line, true, e.problem});
+    if (!t_problems) return;
+    // An element that failed is tried again by everything that refers to it (a medium or BSDF shared by
+    // several shapes): its error is listed once.
+    for (const SceneProblem &p : *t_problems)
+        if (p.error && p.file == e.file && p.line == e.line && p.problem == e.problem) return;
+    t_problems->push_back({e.file, e.line, true, e.problem});
 }
 
 }  // namespace loader
