@@ -147,6 +147,12 @@ TEST(VdbGridVolume, RefusesWhatDoesNotApplyAtTheVolumesLine) {
     EXPECT_NE(error(gridvolume(vol, R"(<string name="grid" value="density"/>)")).find("names a grid of a .vdb file"),
               std::string::npos);
     EXPECT_NE(error(gridvolume(dir + "/absent.vdb")).find("absent.vdb: cannot read the .vdb file"), std::string::npos);
+    // A density below 0, refused as in a .vol, naming the file.
+    const std::string negative = dir + "/negative.vdb";
+    write_vdb(negative, {float_grid("density", openvdb::Coord(0), openvdb::Coord(1), [](int x, int, int) { return x - 0.5f; })});
+    const std::string below = error(gridvolume(negative));
+    EXPECT_NE(below.find(negative + ": the grid holds a value that is not a finite non-negative number"), std::string::npos)
+        << below;
     // The grid named, and use_grid_bbox="true" (what a .vdb does anyway), are accepted.
     EXPECT_EQ(error(gridvolume(vdb, R"(<string name="grid" value="density"/><boolean name="use_grid_bbox" value="true"/>)")), "");
 }

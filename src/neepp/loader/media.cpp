@@ -1,6 +1,7 @@
 // Mitsuba 3's participating media (<medium>) and phase functions (<phase>), and the scene's hold on them.
 #include "neepp/loader/factories.h"
 #include "neepp/loader/problems.h"
+#include "neepp/io/scene_error.h"
 #include "neepp/io/vdb_reader.h"
 #include "neepp/io/volume_grid_reader.h"
 #include "neepp/media/heterogeneous_medium.h"
@@ -61,8 +62,10 @@ std::shared_ptr<const Volume> make_volume(const XmlNode &node) {
         VdbGrid g = read_vdb_grid(path, grid_name);
         o.to_world = o.to_world * g.unit_to_world;
         return std::make_shared<GridVolume>(std::move(g.grid), o);
-    } catch (const std::exception &e) {
+    } catch (const SceneError &e) {  // the reader's, which names the file
         throw node.error(e.what());
+    } catch (const std::exception &e) {  // GridVolume's refusal of the values read
+        throw node.error(path + ": " + e.what());
     }
 }
 
