@@ -6,7 +6,9 @@ set -euo pipefail
 
 PKGS=(cmake ninja-build g++ pkg-config libembree-dev libtbb-dev libopenexr-dev libimath-dev libpugixml-dev
       libjpeg-dev zlib1g-dev libcli11-dev libfmt-dev libstb-dev nlohmann-json3-dev libgtest-dev
-      python3-venv "$@")
+      libopenvdb-dev libboost-iostreams-dev python3-venv "$@")
+# libboost-iostreams-dev: OpenVDB's headers include Boost's and Debian's FindOpenVDB.cmake asks for Boost's
+# iostreams, but libopenvdb-dev does not depend on either.
 
 missing=()
 for p in "${PKGS[@]}"; do

@@ -6,6 +6,8 @@
 #include "neepp/loader/factories.h"
 #include "neepp/loader/problems.h"
 #include "neepp/loader/supported_plugins.h"
+#include "neepp/io/scene_error.h"
+#include "neepp/io/vdb_reader.h"
 #include "neepp/io/volume_grid_reader.h"
 #include "neepp/media/blend_phase.h"
 #include "neepp/media/heterogeneous_medium.h"
@@ -34,18 +36,37 @@ std::shared_ptr<const Volume> make_volume(const XmlNode &node) {
     o.wrap = wrap == "repeat" ? GridVolumeOptions::Wrap::Repeat
              : wrap == "mirror" ? GridVolumeOptions::Wrap::Mirror : GridVolumeOptions::Wrap::Clamp;
     o.to_world = node.get_transform("to_world");
-    o.use_grid_bbox = node.get_bool("use_grid_bbox", false);
     o.max_value = node.get_float("max_value", -1.f, NumberRange::above(0));  // -1: absent, the data's own
     node.get_bool("raw", false);   // the data is used as stored either way in RGB
     node.get_string("accel", "");  // Mitsuba's GPU texture option
-    if (!node.has("filename")) throw node.error("a gridvolume needs a 'filename': its grid as a .vol file");
-    const std::string path = node.resolve_path(node.get_string("filename"));
+    if (!node.has("filename")) throw node.error("a gridvolume needs a 'filename': its grid as a .vol or .vdb file");
+    const std::string filename = node.get_string("filename");
+    const std::string path = node.resolve_path(filename);
+    const bool vdb = filename.size() >= 4 && filename.compare(filename.size() - 4, 4, ".vdb") == 0;
+    if (!vdb) {
+        o.use_grid_bbox = node.get_bool("use_grid_bbox", false);
+        if (node.has("grid")) throw node.property_error("grid", "names a grid of a .vdb file; this gridvolume reads a .vol");
+    } else if (!node.get_bool("use_grid_bbox", true)) {
+        throw node.property_error("use_grid_bbox", "a .vdb grid is always placed by its own transform (as if "
+                                                   "use_grid_bbox were true); to_world then places that in the scene");
+    }
+    const std::string grid_name = vdb ? node.get_string("grid", "") : "";
     try {  // the file's own error, located at the volume using it and naming its use
-        VolumeGrid grid = read_volume_grid(path);  // its errors name the file
-        if (!grid.warning.empty()) warn(node.file, node.line, path + ": " + grid.warning);
+        VolumeGrid grid;
+        if (vdb) {
+            // A .vdb grid lives in its own world space (its voxels through its transform), which to_world
+            // then places in the scene, as pbrt-v4's nanovdb medium places it by the current transform: the
+            // identity leaves the file's coordinates as they are.
+            VdbGrid g = read_vdb_grid(path, grid_name);  // its errors name the file
+            o.to_world = o.to_world * g.unit_to_world;
+            grid = std::move(g.grid);
+        } else {
+            grid = read_volume_grid(path);  // its errors name the file
+            if (!grid.warning.empty()) warn(node.file, node.line, path + ": " + grid.warning);
+        }
         try {
             return std::make_shared<GridVolume>(std::move(grid), o);
-        } catch (const std::invalid_argument &e) {
+        } catch (const std::invalid_argument &e) {  // GridVolume's refusal of the values read
             throw SceneError(path, e.what());
         }
     } catch (const std::exception &e) {
