@@ -17,7 +17,7 @@ struct RenderCounters {
     uint64_t splats = 0;
     // Participating media: density lookups by the paths' free flights, and by the shadow rays'
     // transmittance estimates (ratio tracking: what a shadow ray that NEE++ skips saves), and the shadow
-    // rays that crossed a medium.
+    // rays whose transmittance through a medium was estimated (not those an opaque surface stopped first).
     uint64_t density_lookups = 0;
     uint64_t transmittance_lookups = 0;
     uint64_t medium_shadow_rays = 0;
