@@ -17,12 +17,12 @@ void embree_error(void *, RTCError code, const char *message) {
     std::fprintf(stderr, "Embree error %d: %s\n", int(code), message ? message : "");
 }
 
-// Embree's ray for ours: no motion time, every mask bit, no flags.
-void to_embree(const Ray &ray, RTCRay &r) {
+// Embree's ray for ours: no motion time, the mask of the surfaces it sees (every bit: all), no flags.
+void to_embree(const Ray &ray, RTCRay &r, uint32_t mask = 0xFFFFFFFFu) {
     r.org_x = ray.o.x; r.org_y = ray.o.y; r.org_z = ray.o.z;
     r.dir_x = ray.d.x; r.dir_y = ray.d.y; r.dir_z = ray.d.z;
     r.tnear = ray.tmin; r.tfar = ray.tmax;
-    r.time = 0; r.mask = 0xFFFFFFFFu; r.id = 0; r.flags = 0;
+    r.time = 0; r.mask = mask; r.id = 0; r.flags = 0;
 }
 
 // Embree's packet types and calls for a packet width W (4, 8 or 16 lanes).
@@ -188,12 +188,15 @@ void Scene::build() {
     rtcSetSceneBuildQuality(rtc_scene_, RTC_BUILD_QUALITY_HIGH);
     bounds_ = BBox();
     meshes_.assign(shapes_.size(), nullptr);
+    passable_surfaces_ = false;
     for (size_t i = 0; i < shapes_.size(); ++i) {
         Shape &s = *shapes_[i];
         s.finalize();
+        passable_surfaces_ |= (s.bsdf_flags & BSDFNull) != 0;
         meshes_[i] = dynamic_cast<const TriangleMesh *>(&s);
         RTCGeometry geom = s.embree_geometry(device_);
         if (!geom) continue;  // nothing to intersect; kept so ids stay stable
+        rtcSetGeometryMask(geom, uint32_t((s.bsdf_flags & BSDFNull) ? Surfaces::Passable : Surfaces::Opaque));
         rtcCommitGeometry(geom);
         rtcAttachGeometryByID(rtc_scene_, geom, unsigned(i));
         rtcReleaseGeometry(geom);
@@ -210,10 +213,10 @@ void Scene::build() {
     }
 }
 
-RayHit Scene::trace(const Ray &ray) const {
+RayHit Scene::trace(const Ray &ray, Surfaces seen) const {
     RTCIntersectContext ctx = intersect_context(false);
     RTCRayHit rh;
-    to_embree(ray, rh.ray);
+    to_embree(ray, rh.ray, uint32_t(seen));
     rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
     rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
     rtcIntersect1(rtc_scene_, &ctx, &rh);
@@ -228,8 +231,8 @@ void Scene::trace16(const Ray *const *rays, RayHit *const *hits, int n, bool coh
     with_packet_width(packet_width_, [&](auto w) { intersect_packets<w()>(rtc_scene_, rays, hits, n, coherent); });
 }
 
-bool Scene::intersect(const Ray &ray, SurfaceInteraction &si) const {
-    const RayHit hit = trace(ray);
+bool Scene::intersect(const Ray &ray, SurfaceInteraction &si, Surfaces seen) const {
+    const RayHit hit = trace(ray, seen);
     if (!hit.valid()) {
         si.shape = nullptr;
         return false;
@@ -242,10 +245,10 @@ void Scene::occluded16(const Ray *const *rays, int n, bool *occluded, bool coher
     with_packet_width(packet_width_, [&](auto w) { occluded_packets<w()>(rtc_scene_, rays, n, occluded, coherent); });
 }
 
-bool Scene::occluded(const Ray &ray) const {
+bool Scene::occluded(const Ray &ray, Surfaces seen) const {
     RTCIntersectContext ctx = intersect_context(false);
     RTCRay r;
-    to_embree(ray, r);
+    to_embree(ray, r, uint32_t(seen));
     rtcOccluded1(rtc_scene_, &ctx, &r);
     return r.tfar < 0;  // Embree sets tfar to -inf on a hit
 }

@@ -49,8 +49,12 @@ public:
     // Finalizes shapes, builds the Embree scene and tells lights the scene bounds. Throws on an empty scene.
     void build();
 
-    bool intersect(const Ray &ray, SurfaceInteraction &si) const;  // trace + fill
-    RayHit trace(const Ray &ray) const;
+    // Which surfaces a query sees: all of them, or only those that stop shadow rays (opaque) or only those
+    // that may let them through (passable: a BSDF with BSDFNull). Shadow rays through media ask first
+    // whether an opaque surface blocks them, and walk the passable ones only if none does.
+    enum class Surfaces : uint32_t { All = 0xFFFFFFFFu, Opaque = 1u, Passable = 2u };
+    bool intersect(const Ray &ray, SurfaceInteraction &si, Surfaces seen = Surfaces::All) const;  // trace + fill
+    RayHit trace(const Ray &ray, Surfaces seen = Surfaces::All) const;
     // trace() of up to 16 rays at once, as Embree packets of packet_width(); coherent: the rays start
     // close together in similar directions (camera rays of a few neighbouring pixels), so Embree may use
     // its coherent traversal (it saves work for camera rays; for shadow rays toward lights it costs more).
@@ -72,7 +76,7 @@ public:
         if (mesh && mesh->fills_in_lanes()) add_lane(lanes, *mesh, hit.prim, hit.u, hit.v, hit.t, ray.d, si);
         else fill(hit, ray, si);
     }
-    bool occluded(const Ray &ray) const;
+    bool occluded(const Ray &ray, Surfaces seen = Surfaces::All) const;
     // Up to 16 rays, as packets; coherent as for trace16. The path tracer does not set it: even the shadow
     // rays of the first hits, which leave one pixel, trace slower with it (bench/ray_replay).
     void occluded16(const Ray *const *rays, int n, bool *occluded, bool coherent = false) const;
@@ -85,6 +89,8 @@ public:
     const Medium *add_medium(std::shared_ptr<const Medium> medium);
     bool has_media() const { return !media_.empty(); }
     const std::vector<std::shared_ptr<const Medium>> &media() const { return media_; }
+    // Whether some surface lets a shadow ray through (a null, thin dielectric or mask BSDF: BSDFNull).
+    bool has_passable_surfaces() const { return passable_surfaces_; }
     const std::vector<std::unique_ptr<Shape>> &shapes() const { return shapes_; }
     const std::vector<LightPtr> &lights() const { return lights_; }
     std::vector<const Light *> light_pointers() const;
@@ -106,6 +112,7 @@ private:
     std::vector<const TriangleMesh *> meshes_;
     std::vector<LightPtr> lights_;
     std::vector<std::shared_ptr<const Medium>> media_;
+    bool passable_surfaces_ = false;
     std::vector<const Light *> infinite_lights_;
     BBox bounds_;
 };

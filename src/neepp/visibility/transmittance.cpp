@@ -50,20 +50,32 @@ Color trace_transmittance(const Scene &scene, const Ray &ray, const Medium *medi
     const bool bounded = ray.tmax < kInfinity;
     const Vec3 target = bounded ? ray.at(ray.tmax) : Vec3(0.f);
     Color T(1.f);
-    Ray r = ray;
     bool crossed_medium = false;
+    // First whether an opaque surface blocks the ray (one occlusion query); if none does, the ray is
+    // walked through the surfaces that let light through, the media between them and their boundaries.
+    auto done = [&](const Color &T) {
+        counters.occlusion_ticks += read_ticks() - start;
+        counters.shadow_rays_occluded += !(max_component(T) > 0);
+        counters.medium_shadow_rays += crossed_medium;
+        return T;
+    };
+    if (scene.occluded(ray, Scene::Surfaces::Opaque)) return done(Color(0.f));
+    if (!scene.has_passable_surfaces())  // nothing else on the way, nothing that changes the medium
+        return done(medium ? segment_transmittance(*medium, ray, ray.tmax, channel, sampler, counters, crossed_medium)
+                           : Color(1.f));
+    Ray r = ray;
     // Each surface crossed is one more query; a ray that would cross more than this many has let through
     // nothing worth the time (a stack of thin sheets).
     constexpr int kMaxCrossings = 256;
     for (int crossing = 0;; ++crossing) {
         SurfaceInteraction si;
-        const bool hit = crossing < kMaxCrossings && scene.intersect(r, si);
+        const bool hit = crossing < kMaxCrossings && scene.intersect(r, si, Scene::Surfaces::Passable);
         if (crossing >= kMaxCrossings) {
             T = Color(0.f);
             break;
         }
-        // What the surface ahead lets through, first: behind a wall the segment's transmittance does not
-        // matter, and not estimating it saves a ratio-tracking walk through the medium before the wall.
+        // What the surface ahead lets through, first: where it lets nothing through (a mask opaque there)
+        // the segment's transmittance does not matter, and its ratio-tracking walk is not made.
         const Color through = hit ? si.shape->bsdf->null_transmission(si, si.wi) : Color(1.f);
         if (!(max_component(through) > 0)) {
             T = Color(0.f);
@@ -79,10 +91,7 @@ Color trace_transmittance(const Scene &scene, const Ray &ray, const Medium *medi
         if (bounded) r.tmax = dot(target - r.o, r.d);
         if (bounded && !(r.tmax > 0)) break;
     }
-    counters.occlusion_ticks += read_ticks() - start;
-    counters.shadow_rays_occluded += !(max_component(T) > 0);
-    counters.medium_shadow_rays += crossed_medium;
-    return T;
+    return done(T);
 }
 
 Color test_transmittance(const ShadowRayTester &tester, const Scene &scene, const ShadowQuery &q, const Medium *medium,
