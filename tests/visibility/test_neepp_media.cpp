@@ -13,6 +13,7 @@
 #include "neepp/visibility/map_seeding.h"
 #include "neepp/visibility/neepp_shadow_rays.h"
 #include "test_scenes.h"
+#include "visibility_test_scenes.h"
 
 using namespace neepp;
 using namespace neepp::testing;
@@ -35,21 +36,8 @@ std::string fog_rooms_xml(bool door_closed) {
     <transform name="to_world"><lookat origin="-1.9,1.2,0.7" target="0,0.7,-0.1" up="0,1,0"/></transform>
     <ref id="fog"/>
     <film type="hdrfilm"><integer name="width" value="24"/><integer name="height" value="18"/><rfilter type="box"/></film>
-  </sensor>
-  <bsdf type="twosided" id="white"><bsdf type="diffuse"><rgb name="reflectance" value="0.7"/></bsdf></bsdf>
-  <bsdf type="twosided" id="red"><bsdf type="diffuse"><rgb name="reflectance" value="0.7,0.2,0.2"/></bsdf></bsdf>
-  <shape type="cube"><transform name="to_world"><scale x="2" y="1" z="1"/><translate y="1"/></transform><ref id="white"/>
-    <ref id="fog" name="interior"/></shape>
-  <shape type="cube"><transform name="to_world"><scale x="0.05" y="1" z="0.35"/><translate y="1" z="-0.65"/></transform><ref id="red"/></shape>
-  <shape type="cube"><transform name="to_world"><scale x="0.05" y="1" z="0.35"/><translate y="1" z="0.65"/></transform><ref id="red"/></shape>
-  <shape type="cube"><transform name="to_world"><scale x="0.05" y="0.3" z="0.3"/><translate y="1.7"/></transform><ref id="red"/></shape>
-  <shape type="rectangle"><transform name="to_world"><scale x="0.4" y="0.4"/><rotate x="1" angle="90"/><translate x="1.2" y="1.99"/></transform>
-    <ref id="white"/><emitter type="area"><rgb name="radiance" value="20"/></emitter></shape>
-)";
-    if (door_closed)
-        xml += R"(  <shape type="cube"><transform name="to_world"><scale x="0.04" y="0.7" z="0.3"/><translate y="0.7"/></transform><ref id="white"/></shape>
-)";
-    return xml + "</scene>\n";
+  </sensor>)";
+    return xml + two_rooms_shapes_xml(door_closed, R"(<ref id="fog" name="interior"/>)") + "</scene>\n";
 }
 
 // The fog's density: thin near the floor, denser toward the ceiling and the far room.
@@ -90,20 +78,8 @@ Moments render_moments(const OptionMap &options, uint64_t seed0, MapSetup setup 
             auto *tester = dynamic_cast<NeeppShadowRays *>(&dynamic_cast<PathIntegrator &>(*integ).shadow_rays());
             EXPECT_NE(tester, nullptr);
             if (!tester) return m;
-            if (setup == MapSetup::ClaimsOccluded) {
-                // Ṽ ≈ 1.5e-5 for every pair, the pairs through the door and the fog included.
-                VoxelGrid grid(scene->bounds(), tester->options().voxels);
-                VisibilityMap map(grid.cell_count());
-                for (uint64_t p = 0; p < map.pair_count(); ++p) map.set(p, PairCounts{0, 65535});
-                tester->adopt_map(grid, std::move(map));
-            } else {
-                auto closed = load_scene(fog_rooms(true));
-                NeeppOptions seeding = tester->options();
-                seeding.defer_seeding = false;
-                NeeppShadowRays seeder(seeding);
-                seeder.prepare(*closed);
-                tester->adopt_map(seeder.grid(), seeder.map());
-            }
+            if (setup == MapSetup::ClaimsOccluded) plant_map_claiming_everything_occluded(*tester, *scene);
+            else plant_map_seeded_on(*tester, *load_scene(fog_rooms(true)));
         }
         RenderJob job;
         job.spp = kSpp;
@@ -143,12 +119,7 @@ TEST_P(FogPolicy, StaysUnbiasedWithAMapSeededBehindAClosedDoor) {
     EXPECT_GT(pol.skipped, 0u);
 }
 
-INSTANTIATE_TEST_SUITE_P(Neepp, FogPolicy, ::testing::Values("neepp", "neepp-adaptive", "neepp-cv"),
-                         [](const auto &info) {
-                             std::string s = info.param;
-                             for (char &ch : s) if (ch == '-') ch = '_';
-                             return s;
-                         });
+INSTANTIATE_TEST_SUITE_P(Neepp, FogPolicy, ::testing::Values("neepp", "neepp-adaptive", "neepp-cv"), policy_test_name);
 
 TEST(NeeppThroughFog, VisibilityAwareLightChoiceAndAutoAgreeWithVolumetricNee) {
     expect_same_image(volumetric_nee(), render_moments({{"light_sampler", "visibility"}}, 11003), "light_sampler=visibility");

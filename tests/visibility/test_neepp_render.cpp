@@ -34,22 +34,9 @@ PolicyRun render_policy(const std::string &xml_path, const std::string &policy, 
     if (setup != MapSetup::Built) {
         auto *tester = dynamic_cast<NeeppShadowRays *>(&path->shadow_rays());
         EXPECT_NE(tester, nullptr);
-        if (setup == MapSetup::ClaimsOccluded) {
-            // Every pair claims "never visible" with maximal confidence: Ṽ ≈ 1.5e-5, so q = q_min
-            // everywhere, including the door pairs that are visible.
-            VoxelGrid grid(scene->bounds(), tester->options().voxels);
-            VisibilityMap map(grid.cell_count());
-            for (uint64_t p = 0; p < map.pair_count(); ++p) map.set(p, PairCounts{0, 65535});
-            tester->adopt_map(grid, std::move(map));
-        } else {
-            // Seeded with the door closed, rendered with it open: the door pairs were seen fully occluded.
-            auto closed = load_scene(write_temp_scene(two_rooms_xml(true)));
-            NeeppOptions seeding = tester->options();
-            seeding.defer_seeding = false;  // seeded by prepare(), not after a first pass
-            NeeppShadowRays seeder(seeding);
-            seeder.prepare(*closed);
-            tester->adopt_map(seeder.grid(), seeder.map());
-        }
+        // Seeded with the door closed, rendered with it open: the door pairs were seen fully occluded.
+        if (setup == MapSetup::ClaimsOccluded) plant_map_claiming_everything_occluded(*tester, *scene);
+        else plant_map_seeded_on(*tester, *load_scene(write_temp_scene(two_rooms_xml(true))));
     }
     // neepp-cv's weight is negative for traced, occluded rays: this also checks that the render loop keeps
     // negative samples (dropping them would bias the image and fail the z-tests).
@@ -126,12 +113,7 @@ TEST_P(PolicyTest, AgreesWithNeeForAnEnvironmentThroughAWindow) {
     EXPECT_GT(pol.skipped, 0u);
 }
 
-INSTANTIATE_TEST_SUITE_P(Neepp, PolicyTest, ::testing::Values("neepp", "neepp-adaptive", "neepp-cv"),
-                         [](const auto &info) {
-                             std::string s = info.param;
-                             for (char &ch : s) if (ch == '-') ch = '_';
-                             return s;
-                         });
+INSTANTIATE_TEST_SUITE_P(Neepp, PolicyTest, ::testing::Values("neepp", "neepp-adaptive", "neepp-cv"), policy_test_name);
 
 TEST(NeeppRender, TracesFewerShadowRaysThanNee) {
     PolicyRun nee = render_policy(two_rooms_path(), "nee", 16, 1);

@@ -46,11 +46,8 @@ void record(SplatFilm &film, const std::vector<PSSMLTIntegrator::Contribution> &
 PSSMLTIntegrator::PSSMLTIntegrator(PSSMLTOptions options, std::unique_ptr<Integrator> inner,
                                    std::unique_ptr<Integrator> volumetric)
     : options_(options), plain_(std::move(inner)), volumetric_(std::move(volumetric)) {
+    if (volumetric_) use_inner(volumetric_.get());  // refused here, not at the first scene with media
     use_inner(plain_.get());
-    if (volumetric_) {
-        use_inner(volumetric_.get());
-        use_inner(plain_.get());
-    }
 }
 
 void PSSMLTIntegrator::use_inner(Integrator *inner) {

@@ -68,12 +68,12 @@ Color trace_transmittance(const Scene &scene, const Ray &ray, const Medium *medi
     // nothing worth the time (a stack of thin sheets).
     constexpr int kMaxCrossings = 256;
     for (int crossing = 0;; ++crossing) {
-        SurfaceInteraction si;
-        const bool hit = crossing < kMaxCrossings && scene.intersect(r, si, Scene::Surfaces::Passable);
         if (crossing >= kMaxCrossings) {
             T = Color(0.f);
             break;
         }
+        SurfaceInteraction si;
+        const bool hit = scene.intersect(r, si, Scene::Surfaces::Passable);
         // What the surface ahead lets through, first: where it lets nothing through (a mask opaque there)
         // the segment's transmittance does not matter, and its ratio-tracking walk is not made.
         const Color through = hit ? si.shape->bsdf->null_transmission(si, si.wi) : Color(1.f);
