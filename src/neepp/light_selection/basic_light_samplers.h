@@ -11,6 +11,20 @@ namespace neepp {
 // when no light has power (e.g. black textures), so every light stays selectable.
 std::vector<float> power_fractions(const std::vector<const Light *> &lights);
 
+// A discrete distribution over a list of n lights as one block of 2n + 1 doubles: the cdf over the list's
+// order (n + 1 entries), then each entry's pmf (n, as doubles, which hold the floats exactly). Samplers with a
+// table per voxel miss the cache on each table they read: the search, a zero weight's skip and the pmf then
+// cost one miss, where a Distribution1D and a pmf read back through Light::index cost four in a row.
+// Its sums and pmf are Distribution1D's, so a table draws what one built from a Distribution1D would.
+namespace light_table {
+inline size_t block_size(size_t n) { return 2 * n + 1; }
+// Fills block (block_size(n) doubles) from n weights (NaN, inf or negative ones are never drawn).
+void fill(const std::vector<float> &weights, double *block);
+// The list index drawn by u, and its pmf.
+size_t sample(const double *block, size_t n, float u, float &pmf);
+inline float pmf(const double *block, size_t n, size_t i) { return float(block[n + 1 + i]); }
+}  // namespace light_table
+
 // A fixed discrete distribution over a list of lights whose pmf is read back by Light::index (what a
 // sampler's pmf(ctx, light) receives): sampling reports exactly the float pmf() returns.
 class LightDistribution {
@@ -23,10 +37,9 @@ public:
     float pmf(const Light &light) const {
         return light.index < pmf_by_index_.size() ? pmf_by_index_[light.index] : 0.f;
     }
-    const std::vector<float> &pmf_by_index() const { return pmf_by_index_; }
 
 private:
-    Distribution1D distribution_;      // over the list's order
+    std::vector<double> block_;        // a light_table
     std::vector<float> pmf_by_index_;  // by Light::index
 };
 

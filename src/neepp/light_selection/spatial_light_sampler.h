@@ -61,9 +61,9 @@ public:
     std::string name() const override { return keys_.oriented() ? "spatial-oriented" : "spatial"; }
     nlohmann::json statistics() const override;
 
-    // For samplers built on this one: the table a shading point reads, and that table's pmf by Light::index.
+    // For samplers built on this one: the table a shading point reads, and a light's pmf in that table.
     const TableKeys &keys() const { return keys_; }
-    const std::vector<float> &pmf_table(uint32_t key) const { return tables_.pmf_table(key); }
+    float table_pmf(uint32_t key, const Light &light) const { return tables_.pmf(key, light); }
 
 private:
     SpatialEstimateOptions options_;

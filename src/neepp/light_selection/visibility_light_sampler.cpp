@@ -31,7 +31,7 @@ void VisibilityLightSampler::weights(uint32_t key, std::vector<float> &w) const 
     const size_t n = lights_.size();
     const uint32_t voxel = keys_.voxel(key);
     std::vector<float> base(n);
-    for (size_t l = 0; l < n; ++l) base[l] = spatial_ ? spatial_->pmf_table(key)[lights_[l]->index] : power_[l];
+    for (size_t l = 0; l < n; ++l) base[l] = spatial_ ? spatial_->table_pmf(key, *lights_[l]) : power_[l];
     double total = 0;
     for (size_t l = 0; l < n; ++l) {
         w[l] = base[l] * std::max(visibility_(voxel, *lights_[l]), options_.delta);

@@ -20,8 +20,6 @@ public:
 
     SampledLight sample(uint32_t voxel, float u) const;
     float pmf(uint32_t voxel, const Light &light) const;
-    // The whole pmf of a voxel, indexed by Light::index (for tests and tools).
-    const std::vector<float> &pmf_table(uint32_t voxel) const { return table(voxel).pmf_by_index(); }
 
     // Drops every table (between passes), so they are rebuilt from the current state.
     void clear() { tables_.clear(); }
@@ -29,12 +27,13 @@ public:
     const std::vector<const Light *> &lights() const { return lights_; }
 
 private:
-    const LightDistribution &table(uint32_t voxel) const;
-    std::unique_ptr<LightDistribution> build(uint32_t voxel) const;
+    const double *table(uint32_t voxel) const;  // a light_table over lights_
+    std::unique_ptr<double[]> build(uint32_t voxel) const;
 
     std::vector<const Light *> lights_;
+    std::vector<int32_t> position_;  // by Light::index: its place in lights_, or -1
     WeightFunction weights_;
-    LazyVoxelArray<LightDistribution> tables_;
+    LazyVoxelArray<double[]> tables_;
 };
 
 }  // namespace neepp
