@@ -26,7 +26,7 @@ const std::vector<AutoCandidate> &auto_candidates();
 
 struct AutoPilotResult {
     std::string name;
-    double relative_variance = 0;  // per sample, of the pilot pixels' luminance
+    double relative_variance = 0;  // per sample: mean over the pilot pixels of Var / (mean² + 0.01), of luminance
     double seconds_per_sample = 0;  // CPU time
     double efficiency = 0;          // relative to plain NEE's
     double prepare_s = 0;           // wall time to build its tables and map, and of the unmeasured first pilot pass
@@ -40,9 +40,11 @@ public:
 
     // Efficiency a candidate must reach, relative to plain NEE, to be picked.
     static constexpr double kMargin = 1.15;
-    // Pilot size: pixels on a grid of up to kPilotGrid × kPilotGrid, kPilotSpp samples each.
+    // Pilot size: pixels on a grid of up to kPilotGrid × kPilotGrid, kPilotSpp samples each per pass, one
+    // pass to warm up and kPilotPasses measured.
     static constexpr int kPilotGrid = 48;
     static constexpr int kPilotSpp = 8;
+    static constexpr int kPilotPasses = 4;
 
     void prepare(const Scene &scene) override;
     Color Li(const Scene &scene, const Ray &ray, Sampler &sampler, RenderCounters &counters) const override {
