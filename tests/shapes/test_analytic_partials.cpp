@@ -1,4 +1,4 @@
-// The uv and partials of Mitsuba's analytic shapes (sphere, rectangle) as neepp's hits give
+// The uv and partials of Mitsuba's analytic shapes (sphere, disk, cylinder, rectangle) as neepp's hits give
 // them: at the world point p(u, v) of the shape's parameterisation, written here from Mitsuba 3's
 // definitions, a hit reports that (u, v), dp/du and dp/dv equal to central differences of p, and a shading
 // frame whose s is dp/du made orthogonal to the normal (Mitsuba's). A bump map tilts the normal along
@@ -25,7 +25,7 @@ struct Case {
     std::function<Vec3(float, float)> p;  // Mitsuba's parameterisation, world space
     Vec3 axis_point;                      // a point inside (closed shapes), to aim rays from outside
     bool closed;
-    float uv_tol;
+    float uv_tol;  // disk and cylinder are traced as 256-gon meshes: their hits lie just inside the circle
 };
 
 Vec3 turn(const Vec3 &v) {  // the rotation the sphere's to_world applies: 90° about x, then 30° about y
@@ -47,6 +47,25 @@ std::vector<Case> cases() {
                        return turn(local);
                    },
                    turn(Vec3(0.2f, -0.1f, 0.3f)), true, 1e-4f});
+    // The disk scaled by 1.5 and turned 90° about x: local (x, y, 0) goes to 1.5 (x, 0, y).
+    out.push_back({"disk",
+                   R"(<shape type="disk"><transform name="to_world"><scale value="1.5"/><rotate x="1" angle="90"/><translate y="0.4"/></transform>)",
+                   [](float u, float v) {
+                       const float phi = 2 * kPi * v;
+                       return Vec3(1.5f * u * std::cos(phi), 0.4f, 1.5f * u * std::sin(phi));
+                   },
+                   Vec3(0.f), false, 2e-4f});
+    const Vec3 p0(0.1f, 0.f, -0.2f), p1(0.3f, 1.5f, 0.f);
+    const float radius = 0.6f;
+    const Frame f(normalize(p1 - p0));  // Mitsuba's to_frame of the axis (coordinate_system)
+    out.push_back({"cylinder",
+                   R"(<shape type="cylinder"><point name="p0" x="0.1" y="0" z="-0.2"/><point name="p1" x="0.3" y="1.5" z="0"/>
+                      <float name="radius" value="0.6"/>)",
+                   [=](float u, float v) {
+                       const float phi = 2 * kPi * u;
+                       return p0 + (f.s * std::cos(phi) + f.t * std::sin(phi)) * radius + (p1 - p0) * v;
+                   },
+                   p0, true, 2e-4f});
     // The rectangle [-1, 1]^2 scaled by (2, 0.5) and turned 90° about x: local (x, y, 0) goes to (2x, 0, 0.5y).
     out.push_back({"rectangle",
                    R"(<shape type="rectangle"><transform name="to_world"><scale x="2" y="0.5" z="1"/><rotate x="1" angle="90"/></transform>)",
