@@ -6,7 +6,9 @@ of dp/du and dp/dv) and a normal map over rough plastic (where the map's x and y
 s and t), rendered by neepp's path tracer, agrees with Mitsuba 3's image: the mean within 1 % plus 4
 standard errors, each of 3 x 3 regions within 2 % plus 4 standard errors, and every 12 x 12 block of pixel
 differences passing a z-test. A sphere whose dp/dv had the wrong length and sign, or a disk whose dp/dv did
-not shrink toward its centre (a mesh's, interpolated over each fan triangle), fails the bump-map case."""
+not shrink toward its centre (a mesh's, interpolated over each fan triangle), fails the bump-map case; a bump
+map whose perturbed frame's s was the world dp/du (not Mitsuba's, see materials/bumpmap.cpp) fails the case of
+a bump map over an anisotropic rough conductor."""
 from __future__ import annotations
 
 import numpy as np
@@ -35,6 +37,11 @@ MATERIALS = {
     "bump": f"""<bsdf type="bumpmap">
       <texture name="map" type="bitmap"><string name="filename" value="height.exr"/><boolean name="raw" value="true"/></texture>
       <float name="scale" value="0.08"/>{ROUGH_PLASTIC}</bsdf>""",
+    # The bump map over an anisotropic BSDF, which sees the perturbed frame's s as well as its normal.
+    "anisotropic_bump": f"""<bsdf type="bumpmap">
+      <texture name="map" type="bitmap"><string name="filename" value="height.exr"/><boolean name="raw" value="true"/></texture>
+      <float name="scale" value="0.08"/>
+      <bsdf type="roughconductor"><float name="alpha_u" value="0.12"/><float name="alpha_v" value="0.5"/></bsdf></bsdf>""",
     "normal": f"""<bsdf type="normalmap">
       <texture name="normalmap" type="bitmap"><string name="filename" value="normals.exr"/><boolean name="raw" value="true"/></texture>
       {ROUGH_PLASTIC}</bsdf>""",
@@ -104,8 +111,13 @@ def scene(shape: str, material: str) -> str:
             .replace("@MATERIAL@", MATERIALS[material]))
 
 
-@pytest.mark.parametrize("material", list(MATERIALS))
-@pytest.mark.parametrize("shape", list(SHAPES))
+# Every shape with every material but the anisotropic bump, which goes through the same code on every shape
+# (the bump map's frame) and is tried on two, whose dp/du is along world x at no point.
+CASES = [(shape, material) for shape in SHAPES for material in MATERIALS if material != "anisotropic_bump"] + \
+    [("sphere", "anisotropic_bump"), ("rectangle", "anisotropic_bump")]
+
+
+@pytest.mark.parametrize("shape,material", CASES)
 def test_shape_uv_and_partials_as_in_mitsuba(shape, material, textures, neepp_bin):
     xml = textures / f"{shape}_{material}.xml"
     xml.write_text(scene(shape, material))
@@ -114,4 +126,6 @@ def test_shape_uv_and_partials_as_in_mitsuba(shape, material, textures, neepp_bi
     assert (r.image == r.image).all(), "NaN in the image"
     what = (shape, material)
     assert_agrees(r.image, ref, what)
-    assert_blocks_agree(r.image, ref, what)
+    # A frame turned about the normal moves an anisotropic highlight along thin streaks, which 12-pixel
+    # blocks average away (a wrong s fails 1 to 3 of 12 of them, and 3 to 5 of 48 blocks of 6).
+    assert_blocks_agree(r.image, ref, what, block=6 if material == "anisotropic_bump" else 12)
