@@ -62,7 +62,8 @@ MeshData cube_mesh() {
 }
 
 // Mitsuba's `disk` and `cylinder` are analytic; here they are meshes fine enough that the difference is
-// below any render's noise (a 256-gon's area is 1 - 1e-4 of the circle's), with Mitsuba's normals and uvs.
+// below any render's noise (a 256-gon's area is 1 - 1e-4 of the circle's), with Mitsuba's normals and uvs,
+// and hits on them take the analytic shape's uv, partials and shading normal (shapes/analytic_uv.h).
 constexpr int kRoundSegments = 256;
 
 // `disk`: the unit disk in the z = 0 plane, normal +z, uv = (r, φ / 2π). A fan whose triangles each have
@@ -186,9 +187,11 @@ std::unique_ptr<CurveShape> make_curves(CurveBasis basis, CurveData curves, cons
     return s;
 }
 
-std::unique_ptr<TriangleMesh> make_mesh(MeshData mesh, const Transform &to_world, bool face_normals) {
+std::unique_ptr<TriangleMesh> make_mesh(MeshData mesh, const Transform &to_world, bool face_normals,
+                                        std::optional<AnalyticUv> analytic_uv = std::nullopt) {
     auto s = std::make_unique<TriangleMesh>();
     s->face_normals = face_normals;
+    s->analytic_uv = analytic_uv;  // in the mesh's own space: transform() below takes it to the world
     s->positions = std::move(mesh.positions);
     s->normals = std::move(mesh.normals);
     s->uvs = std::move(mesh.uvs);
@@ -294,9 +297,10 @@ std::unique_ptr<Shape> Factories::build_shape(const XmlNode &node, const XmlNode
         } else if (t == "cube") {
             s = make_mesh(cube_mesh(), to_world, face_normals);
         } else if (t == "disk") {
-            s = make_mesh(disk_mesh(), to_world, face_normals);
+            s = make_mesh(disk_mesh(), to_world, face_normals, AnalyticUv{AnalyticUv::Surface::Disk, {}});
         } else if (t == "cylinder") {
-            s = make_mesh(cylinder_mesh(), to_world * cylinder_frame(node), face_normals);
+            s = make_mesh(cylinder_mesh(), to_world * cylinder_frame(node), face_normals,
+                          AnalyticUv{AnalyticUv::Surface::Cylinder, {}});
         } else if (t == "sphere") {
             auto sphere = std::make_unique<Sphere>();
             sphere->center = node.get_vector("center", Vec3(0.f));

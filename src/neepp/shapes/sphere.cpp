@@ -33,8 +33,17 @@ void Sphere::fill_interaction(uint32_t prim, float, float, const Ray &ray, float
     float phi = std::atan2(local.y, local.x);
     if (phi < 0) phi += 2.f * kPi;
     si.uv = Vec2(phi * kInv2Pi, std::acos(std::clamp(local.z, -1.f, 1.f)) * kInvPi);
+    // Mitsuba's partials of p(u, v) = r (sin θ cos φ, sin θ sin φ, cos θ) with φ = 2π u, θ = π v: dp/dv points
+    // toward the south pole, of length π r. Its length and sign set how far, and which way, a bump map's
+    // slope along v tilts the normal.
     si.dpdu = (axes[1] * local.x - axes[0] * local.y) * (2.f * kPi * radius);
-    si.dpdv = cross(si.n, si.dpdu);
+    const float rd = std::sqrt(local.x * local.x + local.y * local.y);
+    if (rd > 0.f) {
+        const float cos_phi = local.x / rd, sin_phi = local.y / rd;
+        si.dpdv = (axes[0] * (local.z * cos_phi) + axes[1] * (local.z * sin_phi) - axes[2] * rd) * (kPi * radius);
+    } else {
+        si.dpdv = axes[0] * (kPi * radius);  // at a pole, as Mitsuba
+    }
     // Aligned with dp/du where the BSDF reads tangents, as Mitsuba; at the poles dp/du vanishes.
     const float du2 = squared_norm(si.dpdu);
     if (tangents && du2 > 0.f) {

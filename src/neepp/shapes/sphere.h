@@ -14,7 +14,8 @@ public:
 
     BBox bounds() const override;
     RTCGeometry embree_geometry(RTCDevice device) const override;
-    // Mitsuba's uv: (phi / 2pi, theta / pi) in the sphere's frame, dp/du around its z axis.
+    // Mitsuba's uv: (phi / 2pi, theta / pi) in the sphere's frame, with its partials dp/du (around the z
+    // axis) and dp/dv (toward -z).
     void fill_interaction(uint32_t prim, float b1, float b2, const Ray &ray, float t,
                           SurfaceInteraction &si) const override;
     // May translate, rotate, mirror and scale uniformly (the axes turn with it, the radius scales with

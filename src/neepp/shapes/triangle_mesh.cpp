@@ -114,6 +114,7 @@ void TriangleMesh::transform(const Transform &to_world) {
         const float len = norm(n);
         if (len > 0) n = n / len;
     }
+    if (analytic_uv) analytic_uv->to_world = to_world * analytic_uv->to_world;
 }
 
 DirectionCone TriangleMesh::normal_bounds() const {
@@ -168,6 +169,12 @@ PositionSample TriangleMesh::sample_position(Vec2 u, bool with_uv) const {
     ps.ns = shading_normal(hit_triangles_[tri], 1.f - b.x - b.y, b.x, b.y, t.n);
     // Same uv as a ray hit at this point gets (barycentrics without texture coordinates), so textured
     // emission agrees between light sampling and BSDF sampling.
+    if (analytic_uv) {
+        const AnalyticUv::Partials q = analytic_uv->at(ps.p);
+        ps.ns = flip_normals ? -q.n : q.n;
+        ps.uv = q.uv;
+        return ps;
+    }
     if (!with_uv) return ps;
     if (uvs.empty()) {
         ps.uv = b;
@@ -204,6 +211,13 @@ void TriangleMesh::fill_interaction(uint32_t prim, float b1, float b2, const Ray
     si.n = ng;
     si.p = p0 * b0 + p1 * b1 + p2 * b2;
 
+    if (analytic_uv) {
+        const AnalyticUv::Partials q = analytic_uv->at(si.p);
+        si.uv = q.uv, si.dpdu = q.dpdu, si.dpdv = q.dpdv;
+        const Vec3 ns = flip_normals ? -q.n : q.n;  // Mitsuba's analytic shapes have no face_normals
+        si.sh_frame = tangents ? frame_along(ns, si.dpdu) : Frame(ns);
+        return;
+    }
     if (!tangents) {
         si.uv = uvs.empty() ? Vec2(b1, b2) : tri.uv[0] * b0 + tri.uv[1] * b1 + tri.uv[2] * b2;
         si.dpdu = si.dpdv = Vec3(0.f);

@@ -8,6 +8,7 @@
 #include "neepp/base/shape.h"
 #include "neepp/io/mesh_data.h"
 #include "neepp/math/distribution.h"
+#include "neepp/shapes/analytic_uv.h"
 
 namespace neepp {
 
@@ -22,6 +23,10 @@ public:
     // Per-vertex and per-face attributes (of a PLY file), shared by the instances of one mesh.
     std::shared_ptr<const std::vector<MeshAttribute>> attributes;
     bool face_normals = false;  // ignore vertex normals (Mitsuba's face_normals)
+    // Set for the mesh of one of Mitsuba's analytic shapes (disk, cylinder): hits and sampled points take
+    // that shape's uv, partials and shading normal instead of the mesh's interpolated ones. transform()
+    // moves it with the mesh.
+    std::optional<AnalyticUv> analytic_uv;
 
     BBox bounds() const override;
     RTCGeometry embree_geometry(RTCDevice device) const override;
@@ -66,7 +71,8 @@ public:
     // --- For the path tracer's fast form.
     // Whether its hits may be filled eight at a time (shapes/hit_lanes.h): a mesh whose BSDF needs no
     // tangents, which is most of every scene's hits.
-    bool fills_in_lanes() const { return !tangents; }
+    // Not an analytic shape's, whose uv the lanes would interpolate.
+    bool fills_in_lanes() const { return !tangents && !analytic_uv; }
     // Cache prefetch of what fill_interaction(prim) reads: its triangle's record, two cache lines.
     // Inline: it runs once per ray, from the integrator's batch loop.
     void prefetch(uint32_t prim) const {
