@@ -73,7 +73,7 @@ TEST(GridVolumeErrors, EachBrokenFileIsRefusedNamingTheLineTheUseTheFileAndThePr
         {"float16.vol", volume_grid_bytes(float16), "albedo", "data type 2 (only type 1, float32"},
         {"zero.vol", volume_grid_bytes(zero_size), "sigma_t", "size 0 x 2 x 2 is invalid"},
         {"two.vol", volume_grid_bytes(two), "sigma_t", "the grid has 2 channels; a gridvolume's value is grey (1 channel) or RGB (3)"},
-        {"six.vol", volume_grid_bytes(six), "albedo", "the grid has 6 channels"},
+        {"six.vol", volume_grid_bytes(six), "albedo", "the grid has 6 channels; a gridvolume's value is grey (1 channel) or RGB (3) as a medium's albedo (6 channels hold a symmetric matrix"},
         {"two_weight.vol", volume_grid_bytes(two), "weight", "the grid has 2 channels"},
         {"nan.vol", volume_grid_bytes(nan), "sigma_t", "grid point (1, 0, 1) is nan: not a finite number"},
         {"inf.vol", volume_grid_bytes(inf), "sigma_t", "grid point (0, 1, 1), channel 1, is inf: not a finite number"},
@@ -133,3 +133,4 @@ TEST(GridVolumeErrors, DataBeyondTheHeaderLoadsWithAWarning) {
         << problems[0].problem;
     EXPECT_NE(problems[0].problem.find("exactly 3 times as many values"), std::string::npos) << problems[0].problem;
 }
+
