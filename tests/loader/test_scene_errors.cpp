@@ -520,7 +520,7 @@ TEST(SceneErrors, MediaMistakesNameTheirLine) {
     EXPECT_EQ(scene->camera.medium, scene->shapes()[0]->exterior);
     ASSERT_NE(scene->shapes()[0]->interior, nullptr);
     EXPECT_NE(scene->shapes()[0]->interior, scene->shapes()[0]->exterior);
-    EXPECT_EQ(scene->shapes()[0]->interior->majorant(), Color(2.f));
+    EXPECT_EQ(scene->shapes()[0]->interior->majorant(Vec3(0, 0, 1)), Color(2.f));
 }
 
 // rayleigh, tabphase and blendphase: what loads (a blend's nested phase functions in order, its weight a

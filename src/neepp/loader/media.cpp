@@ -237,21 +237,22 @@ const Medium *Factories::medium(const XmlNode &node, bool used) {
     // Mitsuba's switch between two estimators of the same image; neepp always weighs each channel by its
     // own extinction (its spectral route), which is exact for grey media too.
     node.get_bool("has_spectral_extinction", true);
+    if (!phase) phase = std::make_shared<IsotropicPhase>();
     std::shared_ptr<Medium> m;
     if (node.type == "homogeneous") {
         if (!std::dynamic_pointer_cast<const ConstantVolume>(sigma_t))
             throw node.error("a homogeneous medium's sigma_t is one value (a <float>, <rgb>, <spectrum> or constvolume); "
                              "a grid of them makes a heterogeneous medium");
-        m = std::make_shared<HomogeneousMedium>(sigma_t->eval(Vec3(0.f)) * scale, albedo);
+        m = std::make_shared<HomogeneousMedium>(sigma_t->eval(Vec3(0.f)) * scale, albedo, phase);
     } else {
-        m = std::make_shared<HeterogeneousMedium>(sigma_t, albedo, scale);
+        m = std::make_shared<HeterogeneousMedium>(sigma_t, albedo, scale, phase);
     }
     // Each is a float, their product need not be: an infinite extinction would make every free flight 0
     // long and every transmittance NaN.
-    if (const Color bound = m->majorant(); !std::isfinite(bound.x) || !std::isfinite(bound.y) || !std::isfinite(bound.z))
+    const float bound = max_component(sigma_t->max() * scale * Color(phase->max_projected_area()));
+    if (!std::isfinite(bound))
         throw node.error("sigma_t times scale is not a finite number (the largest sigma_t " +
                          std::to_string(sigma_t->max()) + ", scale " + std::to_string(scale) + ")");
-    m->phase = phase ? phase : std::make_shared<IsotropicPhase>();
     m->sample_emitters = node.get_bool("sample_emitters", true);
     warn_unused(node);
     media_[&node] = m;
