@@ -13,6 +13,7 @@
 #include "neepp/media/heterogeneous_medium.h"
 #include "neepp/media/homogeneous_medium.h"
 #include "neepp/media/phase_functions.h"
+#include "neepp/media/sggx_phase.h"
 #include "neepp/media/tabulated_phase.h"
 
 namespace neepp::loader {
@@ -159,6 +160,19 @@ std::shared_ptr<const PhaseFunction> make_phase(const XmlNode &node) {
     }
     if (node.type == "rayleigh") return std::make_shared<RayleighPhase>();
     if (node.type == "tabphase") return std::make_shared<TabulatedPhase>(tabulated_values(node));
+    if (node.type == "sggx") {
+        for (size_t i = 0; i < node.children.size(); ++i)
+            if (node.children[i]->tag != "volume" || node.child_names[i] != "S")
+                throw node.children[i]->error("an sggx holds one <volume> named \"S\", not a <" + node.children[i]->tag +
+                                              "> named \"" + node.child_names[i] + "\"");
+        const std::shared_ptr<XmlNode> child = node.child("S");
+        if (!child)
+            throw node.error("an sggx needs its 'S': a <volume> of 6 channels (S_xx, S_yy, S_zz, S_xy, S_xz, S_yz), the "
+                             "microflakes' matrix (a gridvolume, or a constvolume whose value is a string of six numbers)");
+        auto S = located_at(*child, [&] { return make_volume(*child, {"an sggx's S", true}); });
+        warn_unused(*child);
+        return std::make_shared<SGGXPhase>(S);
+    }
     if (node.type == "blendphase") {
         std::vector<std::shared_ptr<const PhaseFunction>> nested;
         for (size_t i = 0; i < node.children.size(); ++i) {
@@ -243,6 +257,14 @@ const Medium *Factories::medium(const XmlNode &node, bool used) {
         if (!std::dynamic_pointer_cast<const ConstantVolume>(sigma_t))
             throw node.error("a homogeneous medium's sigma_t is one value (a <float>, <rgb>, <spectrum> or constvolume); "
                              "a grid of them makes a heterogeneous medium");
+        // Its extinction is sigma_t times the flakes' projected area: the same everywhere only if S is.
+        // (Mitsuba takes its majorant from S at the origin and would be biased wherever S differs.)
+        if (const auto *sggx = dynamic_cast<const SGGXPhase *>(phase.get())) {
+            const auto *grid = dynamic_cast<const GridVolume *>(&sggx->S());
+            if (grid && !grid->uniform())
+                throw node.error("a homogeneous medium's sggx S is the same everywhere (a constvolume, or a grid whose "
+                                 "points all hold one matrix): S that varies makes the extinction vary, a heterogeneous medium");
+        }
         m = std::make_shared<HomogeneousMedium>(sigma_t->eval(Vec3(0.f)) * scale, albedo, phase);
     } else {
         m = std::make_shared<HeterogeneousMedium>(sigma_t, albedo, scale, phase);
