@@ -73,7 +73,7 @@ TEST(GridVolumeErrors, EachBrokenFileIsRefusedNamingTheLineTheUseTheFileAndThePr
         {"float16.vol", volume_grid_bytes(float16), "albedo", "data type 2 (only type 1, float32"},
         {"zero.vol", volume_grid_bytes(zero_size), "sigma_t", "size 0 x 2 x 2 is invalid"},
         {"two.vol", volume_grid_bytes(two), "sigma_t", "the grid has 2 channels; a gridvolume's value is grey (1 channel) or RGB (3)"},
-        {"six.vol", volume_grid_bytes(six), "albedo", "the grid has 6 channels"},
+        {"six.vol", volume_grid_bytes(six), "albedo", "the grid has 6 channels; a gridvolume's value is grey (1 channel) or RGB (3) as a medium's albedo (6 channels hold a symmetric matrix"},
         {"two_weight.vol", volume_grid_bytes(two), "weight", "the grid has 2 channels"},
         {"nan.vol", volume_grid_bytes(nan), "sigma_t", "grid point (1, 0, 1) is nan: not a finite number"},
         {"inf.vol", volume_grid_bytes(inf), "sigma_t", "grid point (0, 1, 1), channel 1, is inf: not a finite number"},
@@ -132,4 +132,46 @@ TEST(GridVolumeErrors, DataBeyondTheHeaderLoadsWithAWarning) {
               std::string::npos)
         << problems[0].problem;
     EXPECT_NE(problems[0].problem.find("exactly 3 times as many values"), std::string::npos) << problems[0].problem;
+}
+
+// An sggx's S is a 6-channel grid: one of other channel counts, or of matrices that are not positive
+// semi-definite, is refused at the volume's line naming the file; in a homogeneous medium S must be the same
+// at every grid point (else the extinction would vary through it).
+TEST(GridVolumeErrors, SggxSIsAGridOfSymmetricMatrices) {
+    TempDir dir;
+    auto sggx_scene = [&](const std::string &vol, const std::string &medium = "heterogeneous") {
+        return dir.write("scene.xml", R"(<scene version="3.0.0">
+<sensor type="perspective"><film type="hdrfilm"><integer name="width" value="8"/><integer name="height" value="8"/></film></sensor>
+<emitter type="constant"/>
+<shape type="cube"><bsdf type="null"/><medium type=")" + medium + R"(" name="interior"><phase type="sggx">
+<volume name="S" type="gridvolume"><string name="filename" value=")" + vol + R"("/></volume>
+</phase></medium></shape>
+</scene>
+)");
+    };
+    VolumeGridFile identity = grid(6);
+    for (size_t i = 0; i < identity.values.size(); ++i) identity.values[i] = i % 6 < 3 ? 1.f : 0.f;
+    EXPECT_EQ(load_error(sggx_scene(dir.write("identity.vol", volume_grid_bytes(identity)))), "");
+    EXPECT_EQ(load_error(sggx_scene(dir.write("identity.vol", volume_grid_bytes(identity)), "homogeneous")), "");
+    VolumeGridFile varying = identity, indefinite = identity;
+    varying.values[6 * 7 + 2] = 0.01f;      // point (1, 1, 1): a fibre
+    indefinite.values[6 * 3 + 4] = -1.5f;   // point (1, 1, 0): S_xz beyond its diagonal
+    struct Case {
+        std::string file, bytes, medium, problem;
+    };
+    const std::vector<Case> cases = {
+        {"grey.vol", volume_grid_bytes(grid(1)), "heterogeneous", "the grid has 1 channel; an sggx's S is a symmetric matrix, 6 channels"},
+        {"rgb.vol", volume_grid_bytes(grid(3)), "heterogeneous", "the grid has 3 channels; an sggx's S is a symmetric matrix"},
+        {"indefinite.vol", volume_grid_bytes(indefinite), "heterogeneous", "at grid point (1, 1, 0) has an eigenvalue of -"},
+    };
+    for (const Case &c : cases) {
+        const std::string vol = dir.write(c.file, c.bytes), xml = sggx_scene(vol, c.medium);
+        const std::string msg = load_error(xml);
+        EXPECT_NE(msg.find(xml + ":5: <volume type=\"gridvolume\">: as \"S\": " + vol + ": "), std::string::npos) << c.file << ": " << msg;
+        EXPECT_NE(msg.find(c.problem), std::string::npos) << c.file << ": " << msg;
+    }
+    const std::string vol = dir.write("varying.vol", volume_grid_bytes(varying));
+    EXPECT_EQ(load_error(sggx_scene(vol)), "");
+    const std::string msg = load_error(sggx_scene(vol, "homogeneous"));
+    EXPECT_NE(msg.find(":4: <medium type=\"homogeneous\">: a homogeneous medium's sggx S is the same everywhere"), std::string::npos) << msg;
 }

@@ -65,6 +65,10 @@ const TempDir &aux_files() {
         VolumeGridFile density;
         density.values.assign(8, 0.5f);
         dir.write("density.vol", volume_grid_bytes(density));
+        VolumeGridFile identity;  // 2 x 2 x 2 matrices S = I (sggx's S)
+        identity.channels = 6;
+        for (int i = 0; i < 8 * 6; ++i) identity.values.push_back(i % 6 < 3 ? 1.f : 0.f);
+        dir.write("sggx.vol", volume_grid_bytes(identity));
         Image img(2, 2, 3);
         std::fill(img.data.begin(), img.data.end(), 0.5f);
         write_exr((dir.dir / "image.exr").string(), img);
@@ -225,7 +229,10 @@ std::map<std::string, std::map<std::string, PluginCase>> plugin_cases() {
                           {accepted("weight", "float")}, R"(<float name="weight" value="0.5"/>)"}},
           // Its numbers are in a string; each is checked as a <float> would be, and a density is not negative.
           {"tabphase", {R"(<shape type="sphere"><bsdf type="null"/><medium type="homogeneous" name="interior"><phase type="tabphase">@</phase></medium></shape>)",
-                        {refused("values", "string")}, R"(<string name="values" value="1, 2"/>)"}}}},
+                        {refused("values", "string")}, R"(<string name="values" value="1, 2"/>)"}},
+          // Its one property is a volume (a 6-channel gridvolume in Mitsuba 3), whose numbers are in a file.
+          {"sggx", {R"(<shape type="sphere"><bsdf type="null"/><medium type="homogeneous" name="interior"><phase type="sggx">@</phase></medium></shape>)",
+                    {}, R"(<volume name="S" type="gridvolume"><string name="filename" value=")" + aux("sggx.vol") + R"("/></volume>)"}}}},
         {"film",
          {{"hdrfilm", {sensor("perspective", "<film type=\"hdrfilm\">@</film>"),
                        {refused("width", "integer"), refused("height", "integer"), refused("crop_offset_x", "integer"),

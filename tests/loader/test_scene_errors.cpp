@@ -9,6 +9,7 @@
 #include "neepp/materials/principledthin.h"
 #include "neepp/media/blend_phase.h"
 #include "neepp/media/phase_functions.h"
+#include "neepp/media/sggx_phase.h"
 #include "neepp/media/tabulated_phase.h"
 #include "test_scenes.h"
 
@@ -520,7 +521,7 @@ TEST(SceneErrors, MediaMistakesNameTheirLine) {
     EXPECT_EQ(scene->camera.medium, scene->shapes()[0]->exterior);
     ASSERT_NE(scene->shapes()[0]->interior, nullptr);
     EXPECT_NE(scene->shapes()[0]->interior, scene->shapes()[0]->exterior);
-    EXPECT_EQ(scene->shapes()[0]->interior->majorant(), Color(2.f));
+    EXPECT_EQ(scene->shapes()[0]->interior->majorant(Vec3(0, 0, 1)), Color(2.f));
 }
 
 // rayleigh, tabphase and blendphase: what loads (a blend's nested phase functions in order, its weight a
@@ -565,6 +566,52 @@ TEST(SceneErrors, PhaseFunctionsLoadAndTheirMistakesNameTheirLine) {
          "not a <texture>"},
         {R"(<phase type="blendphase"><phase type="isotropic"/><phase type="isotropic"/><volume name="weights" type="constvolume"/></phase>)",
          "a blendphase's volume is its \"weight\", not \"weights\""},
+    };
+    for (const auto &[phase, needle] : mistakes) {
+        const std::string msg = load_error(in_medium(phase));
+        EXPECT_NE(msg.find(".xml:4:"), std::string::npos) << phase << ": " << msg;
+        EXPECT_NE(msg.find(needle), std::string::npos) << phase << ": " << msg;
+    }
+}
+
+// sggx: S from a constvolume of six numbers (neepp's) makes the phase function and scales the medium's
+// extinction by the projected area; each mistake is an error at its line (a 6-channel grid's are in
+// test_grid_volume_errors.cpp).
+TEST(SceneErrors, SggxLoadsItsSAndItsMistakesNameTheirLine) {
+    auto in_medium = [](const std::string &phase, const std::string &type = "homogeneous") {
+        return scene_with("<shape type=\"sphere\"><bsdf type=\"null\"/><medium type=\"" + type +
+                          "\" name=\"interior\"><float name=\"sigma_t\" value=\"2\"/>\n" + phase + "\n</medium></shape>\n" + kLight);
+    };
+    const auto scene = load_scene(write_temp_scene(in_medium(
+        R"(<phase type="sggx"><volume name="S" type="constvolume"><string name="value" value="1, 0.25, 0.04, 0, 0, 0"/></volume></phase>)")));
+    const Medium &m = *scene->shapes()[0]->interior;
+    const auto sggx = std::dynamic_pointer_cast<const SGGXPhase>(m.phase);
+    ASSERT_TRUE(sggx);
+    EXPECT_FLOAT_EQ(sggx->projected_area(Vec3(0.f), Vec3(0, 1, 0)), 0.5f);
+    EXPECT_FLOAT_EQ(m.majorant(Vec3(0, 1, 0)).x, 1.f);   // 2 x sqrt(0.25)
+    EXPECT_FLOAT_EQ(m.majorant(Vec3(0, 0, -1)).y, 0.4f);  // 2 x sqrt(0.04)
+    EXPECT_TRUE(m.homogeneous());
+    // In a heterogeneous medium the majorant bounds every direction: sqrt of S's largest eigenvalue.
+    const auto het = load_scene(write_temp_scene(in_medium(
+        R"(<phase type="sggx"><volume name="S" type="constvolume"><string name="value" value="4, 1, 1, 0, 0, 0"/></volume></phase>)",
+        "heterogeneous")));
+    EXPECT_FLOAT_EQ(het->shapes()[0]->interior->majorant(Vec3(0, 1, 0)).x, 4.f);
+
+    // The phase function is on the scene's line 4.
+    const std::vector<std::pair<std::string, std::string>> mistakes = {
+        {R"(<phase type="sggx"/>)", "an sggx needs its 'S'"},
+        {R"(<phase type="sggx"><volume name="s" type="constvolume"><string name="value" value="1 1 1 0 0 0"/></volume></phase>)",
+         "an sggx holds one <volume> named \"S\""},
+        {R"(<phase type="sggx"><volume name="S" type="constvolume"><rgb name="value" value="1"/></volume></phase>)",
+         "an sggx's S is a symmetric matrix: a string of six numbers"},
+        {R"(<phase type="sggx"><volume name="S" type="constvolume"><string name="value" value="1 1 1 0 0"/></volume></phase>)",
+         "six numbers S_xx, S_yy, S_zz, S_xy, S_xz, S_yz (found 5)"},
+        {R"(<phase type="sggx"><volume name="S" type="constvolume"><string name="value" value="1 1 1 0 x 0"/></volume></phase>)",
+         "\"x\" is not a number"},
+        {R"(<phase type="sggx"><volume name="S" type="constvolume"><string name="value" value="1 1 1 2 0 0"/></volume></phase>)",
+         "not positive semi-definite"},
+        {R"(<phase type="blendphase"><phase type="isotropic"/><phase type="isotropic"/><volume name="weight" type="constvolume"><string name="value" value="1 1 1 0 0 0"/></volume></phase>)",
+         "six numbers are a symmetric matrix (an sggx's S), not a blendphase's weight"},
     };
     for (const auto &[phase, needle] : mistakes) {
         const std::string msg = load_error(in_medium(phase));

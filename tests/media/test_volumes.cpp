@@ -85,12 +85,13 @@ TEST(GridVolume, RefusesBadGridsSayingWhere) {
         return "";
     };
     auto contains = [](const std::string &msg, const std::string &needle) { return msg.find(needle) != std::string::npos; };
-    for (int channels : {2, 4, 6}) {  // Mitsuba's 6-channel grids are for SGGX, which neepp does not render
+    for (int channels : {2, 4, 5, 7}) {
         VolumeGrid g = ramp();
         g.channels = uint32_t(channels);
         g.values.resize(4 * 2 * 2 * size_t(channels), 0.f);
         const std::string msg = message(g);
-        EXPECT_TRUE(contains(msg, "has " + std::to_string(channels) + " channels; a gridvolume's value is grey (1 channel) or RGB (3)"))
+        EXPECT_TRUE(contains(msg, "has " + std::to_string(channels) +
+                                      " channels; a gridvolume's value is grey (1 channel), RGB (3) or a symmetric matrix (6"))
             << msg;
     }
     VolumeGrid negative = ramp();
@@ -127,4 +128,56 @@ TEST(ConstantVolume, IsDefinedOverTheUnitCubeItsToWorldPlaces) {
     EXPECT_EQ(v.bounds().hi, Vec3(0.5f));
     EXPECT_FLOAT_EQ(v.max(), 0.5f);
     EXPECT_EQ(ConstantVolume(Color(1.f)).bounds().hi, Vec3(1.f));
+}
+
+// Six channels: a symmetric matrix at each point (S_xx, S_yy, S_zz, S_xy, S_xz, S_yz, an sggx phase
+// function's S), each entry interpolated as a colour's channels; its max the largest eigenvalue anywhere.
+TEST(GridVolume, SixChannelsAreSymmetricMatrices) {
+    VolumeGrid g;
+    g.size[0] = 2, g.size[1] = 1, g.size[2] = 1, g.channels = 6;
+    // diag(1, 1, 0.01), then a rotated matrix with negative entries off the diagonal (eigenvalues 3, 1, 1).
+    g.values = {1.f, 1.f, 0.01f, 0.f, 0.f, 0.f, 5.f / 3.f, 5.f / 3.f, 5.f / 3.f, -2.f / 3.f, -2.f / 3.f, 2.f / 3.f};
+    const GridVolume v(g, {});
+    EXPECT_EQ(v.channels(), 6);
+    EXPECT_FALSE(v.uniform());
+    EXPECT_NEAR(v.max(), 3.f, 1e-5f);
+    const SymmetricMatrix3 a = v.eval_matrix(Vec3(0.1f, 0.5f, 0.5f)), mid = v.eval_matrix(Vec3(0.5f, 0.5f, 0.5f));
+    EXPECT_EQ(a, SymmetricMatrix3(1.f, 1.f, 0.01f, 0.f, 0.f, 0.f));
+    EXPECT_FLOAT_EQ(mid.zz, (0.01f + 5.f / 3.f) / 2);
+    EXPECT_FLOAT_EQ(mid.xz, -1.f / 3.f);
+    EXPECT_FLOAT_EQ(mid.yz, 1.f / 3.f);
+    GridVolumeOptions nearest;
+    nearest.filter = GridVolumeOptions::Filter::Nearest;
+    EXPECT_FLOAT_EQ(GridVolume(g, nearest).eval_matrix(Vec3(0.6f, 0.5f, 0.5f)).xy, -2.f / 3.f);
+    // Every point the same matrix: uniform (a homogeneous medium may take its S from such a grid).
+    VolumeGrid same = g;
+    std::copy(g.values.begin(), g.values.begin() + 6, same.values.begin() + 6);
+    EXPECT_TRUE(GridVolume(same, {}).uniform());
+    EXPECT_FALSE(GridVolume(ramp(), {}).uniform());
+    // A matrix that is not positive semi-definite (an eigenvalue of -1), or not finite, is refused where it is.
+    auto message = [](const VolumeGrid &grid) -> std::string {
+        try {
+            GridVolume bad(grid, {});
+        } catch (const std::invalid_argument &e) {
+            return e.what();
+        }
+        return "";
+    };
+    VolumeGrid indefinite = g;
+    indefinite.values[6 + 3] = 2.f + 5.f / 3.f;  // point (1, 0, 0): S_xy too large for its diagonal
+    EXPECT_NE(message(indefinite).find("the matrix (S_xx, S_yy, S_zz, S_xy, S_xz, S_yz) at grid point (1, 0, 0) has an eigenvalue of -"),
+              std::string::npos)
+        << message(indefinite);
+    EXPECT_NE(message(indefinite).find("not positive semi-definite"), std::string::npos) << message(indefinite);
+    VolumeGrid nan = g;
+    nan.values[4] = NAN;
+    EXPECT_NE(message(nan).find("at grid point (0, 0, 0) holds nan: not a finite number"), std::string::npos) << message(nan);
+}
+
+TEST(ConstantVolume, SixValuesAreAMatrix) {
+    const ConstantVolume v(SymmetricMatrix3(0.5f, 0.25f, 2.f, 0.f, 0.f, 0.f));
+    EXPECT_EQ(v.channels(), 6);
+    EXPECT_FLOAT_EQ(v.max(), 2.f);
+    EXPECT_EQ(v.eval_matrix(Vec3(3.f)), SymmetricMatrix3(0.5f, 0.25f, 2.f, 0.f, 0.f, 0.f));
+    EXPECT_EQ(ConstantVolume(Color(0.2f)).channels(), 3);
 }

@@ -13,16 +13,78 @@
 #include "neepp/media/heterogeneous_medium.h"
 #include "neepp/media/homogeneous_medium.h"
 #include "neepp/media/phase_functions.h"
+#include "neepp/media/sggx_phase.h"
 #include "neepp/media/tabulated_phase.h"
 
 namespace neepp::loader {
 
 namespace {
 
-// A <volume> (constvolume or gridvolume) as Mitsuba 3 reads it.
-std::shared_ptr<const Volume> make_volume(const XmlNode &node) {
-    if (node.type == "constvolume")
+// The numbers of a string property, separated by spaces or commas, each finite as a float (as any number
+// a scene gives) and, where `negative` is false, not below 0.
+std::vector<float> numbers_in(const XmlNode &node, const std::string &prop, bool negative) {
+    const std::string text = node.get_string(prop);
+    std::vector<float> values;
+    size_t at = 0;
+    while ((at = text.find_first_not_of(" ,\t\n\r", at)) != std::string::npos) {
+        const size_t end = text.find_first_of(" ,\t\n\r", at);
+        const std::string token = text.substr(at, end == std::string::npos ? std::string::npos : end - at);
+        at = end;
+        char *stop = nullptr;
+        const double v = std::strtod(token.c_str(), &stop);
+        if (stop != token.c_str() + token.size())
+            throw node.property_error(prop, "\"" + token + "\" is not a number");
+        if (!std::isfinite(v) || std::abs(v) > std::numeric_limits<float>::max())
+            throw node.property_error(prop, "\"" + token + "\" is not a finite number");
+        if (v < 0 && !negative) throw node.property_error(prop, "\"" + token + "\" is negative: the values are a density");
+        values.push_back(float(v));
+    }
+    return values;
+}
+
+// A constvolume of six values, a symmetric matrix: neepp's, as a string of numbers (Mitsuba 3's constvolume
+// has no 6-channel lookup, so its sggx reads S from a gridvolume only).
+std::shared_ptr<const Volume> constant_matrix_volume(const XmlNode &node) {
+    const std::vector<float> v = numbers_in(node, "value", true);
+    if (v.size() != 6)
+        throw node.property_error("value", "a string value is a symmetric matrix, six numbers S_xx, S_yy, S_zz, S_xy, "
+                                           "S_xz, S_yz (found " + std::to_string(v.size()) + ")");
+    try {
+        return std::make_shared<ConstantVolume>(SymmetricMatrix3::from_channels(v.data()), node.get_transform("to_world"));
+    } catch (const std::invalid_argument &e) {
+        throw node.property_error("value", e.what());
+    }
+}
+
+// What a volume is read as where it is used: a colour (a medium's sigma_t and albedo, a blendphase's weight:
+// grey, 1 channel, or RGB, 3) or a symmetric matrix (an sggx's S: 6 channels).
+struct VolumeUse {
+    std::string name;  // "a medium's sigma_t"
+    bool matrix = false;
+};
+
+// Why a grid of `channels` channels does not fit its use, or empty when it does.
+std::string channel_problem(uint32_t channels, const VolumeUse &use) {
+    const std::string has = "the grid has " + std::to_string(channels) + (channels == 1 ? " channel; " : " channels; ");
+    if (use.matrix)
+        return channels == 6 ? "" : has + use.name + " is a symmetric matrix, 6 channels (S_xx, S_yy, S_zz, S_xy, S_xz, S_yz)";
+    if (channels == 1 || channels == 3) return "";
+    return has + "a gridvolume's value is grey (1 channel) or RGB (3) as " + use.name +
+           (channels == 6 ? " (6 channels hold a symmetric matrix, an sggx phase function's S)" : "");
+}
+
+// A <volume> (constvolume or gridvolume) as Mitsuba 3 reads it, for `use`.
+std::shared_ptr<const Volume> make_volume(const XmlNode &node, const VolumeUse &use) {
+    if (node.type == "constvolume") {
+        const bool six = node.has("value") && node.props.at("value").kind == XmlProperty::Kind::String;
+        if (six != use.matrix)
+            throw node.property_error("value", six ? "six numbers are a symmetric matrix (an sggx's S), not " + use.name +
+                                                         " (a <float>, <rgb> or <spectrum>)"
+                                                   : use.name + " is a symmetric matrix: a string of six numbers S_xx, "
+                                                                "S_yy, S_zz, S_xy, S_xz, S_yz");
+        if (six) return constant_matrix_volume(node);
         return std::make_shared<ConstantVolume>(node.get_unbounded_rgb("value", Color(1.f)), node.get_transform("to_world"));
+    }
     if (node.type != "gridvolume" && node.type != "grid")
         throw node.error("unsupported volume '" + node.type + "' (supported: constvolume, gridvolume)");
     GridVolumeOptions o;
@@ -64,6 +126,8 @@ std::shared_ptr<const Volume> make_volume(const XmlNode &node) {
             grid = read_volume_grid(path);  // its errors name the file
             if (!grid.warning.empty()) warn(node.file, node.line, path + ": " + grid.warning);
         }
+        // Whether its channels fit the use first: a colour's checks would refuse a matrix's negative entries.
+        if (const std::string problem = channel_problem(grid.channels, use); !problem.empty()) throw SceneError(path, problem);
         try {
             return std::make_shared<GridVolume>(std::move(grid), o);
         } catch (const std::invalid_argument &e) {  // GridVolume's refusal of the values read
@@ -79,23 +143,7 @@ std::vector<float> tabulated_values(const XmlNode &node) {
     if (!node.has("values"))
         throw node.error("a tabphase needs its 'values': a string of numbers, the density at cosines evenly spaced "
                          "from -1 (backward) to 1 (forward)");
-    const std::string text = node.get_string("values");
-    std::vector<float> values;
-    size_t at = 0;
-    while ((at = text.find_first_not_of(" ,\t\n\r", at)) != std::string::npos) {
-        const size_t end = text.find_first_of(" ,\t\n\r", at);
-        const std::string token = text.substr(at, end == std::string::npos ? std::string::npos : end - at);
-        at = end;
-        char *stop = nullptr;
-        const double v = std::strtod(token.c_str(), &stop);
-        if (stop != token.c_str() + token.size())
-            throw node.property_error("values", "\"" + token + "\" is not a number");
-        // As any number a scene gives: finite as a float, and a density cannot be negative.
-        if (!std::isfinite(v) || std::abs(v) > std::numeric_limits<float>::max())
-            throw node.property_error("values", "\"" + token + "\" is not a finite number");
-        if (v < 0) throw node.property_error("values", "\"" + token + "\" is negative: the values are a density");
-        values.push_back(float(v));
-    }
+    const std::vector<float> values = numbers_in(node, "values", false);
     if (values.size() < 2)
         throw node.property_error("values", "needs at least two numbers (the density at cos_theta = -1 and 1)");
     if (std::all_of(values.begin(), values.end(), [](float v) { return v == 0.f; }))
@@ -112,6 +160,19 @@ std::shared_ptr<const PhaseFunction> make_phase(const XmlNode &node) {
     }
     if (node.type == "rayleigh") return std::make_shared<RayleighPhase>();
     if (node.type == "tabphase") return std::make_shared<TabulatedPhase>(tabulated_values(node));
+    if (node.type == "sggx") {
+        for (size_t i = 0; i < node.children.size(); ++i)
+            if (node.children[i]->tag != "volume" || node.child_names[i] != "S")
+                throw node.children[i]->error("an sggx holds one <volume> named \"S\", not a <" + node.children[i]->tag +
+                                              "> named \"" + node.child_names[i] + "\"");
+        const std::shared_ptr<XmlNode> child = node.child("S");
+        if (!child)
+            throw node.error("an sggx needs its 'S': a <volume> of 6 channels (S_xx, S_yy, S_zz, S_xy, S_xz, S_yz), the "
+                             "microflakes' matrix (a gridvolume, or a constvolume whose value is a string of six numbers)");
+        auto S = located_at(*child, [&] { return make_volume(*child, {"an sggx's S", true}); });
+        warn_unused(*child);
+        return std::make_shared<SGGXPhase>(S);
+    }
     if (node.type == "blendphase") {
         std::vector<std::shared_ptr<const PhaseFunction>> nested;
         for (size_t i = 0; i < node.children.size(); ++i) {
@@ -134,7 +195,7 @@ std::shared_ptr<const PhaseFunction> make_phase(const XmlNode &node) {
         // (so any finite number is accepted). Mitsuba has no default.
         std::shared_ptr<const Volume> weight;
         if (std::shared_ptr<XmlNode> child = node.child("weight")) {
-            weight = located_at(*child, [&] { return make_volume(*child); });
+            weight = located_at(*child, [&] { return make_volume(*child, {"a blendphase's weight"}); });
             warn_unused(*child);
         } else if (node.has("weight")) {
             weight = std::make_shared<ConstantVolume>(Color(node.get_float("weight")));
@@ -154,7 +215,7 @@ std::shared_ptr<const Volume> Factories::volume_param(const XmlNode &node, const
         if (child->tag != "volume")
             throw child->error("a medium's '" + name + "' is a <volume>, a <float>, an <rgb> or a <spectrum>, not a <" +
                                child->tag + ">");
-        auto v = located_at(*child, [&] { return make_volume(*child); });
+        auto v = located_at(*child, [&] { return make_volume(*child, {"a medium's " + name}); });
         warn_unused(*child);
         return v;
     }
@@ -190,21 +251,30 @@ const Medium *Factories::medium(const XmlNode &node, bool used) {
     // Mitsuba's switch between two estimators of the same image; neepp always weighs each channel by its
     // own extinction (its spectral route), which is exact for grey media too.
     node.get_bool("has_spectral_extinction", true);
+    if (!phase) phase = std::make_shared<IsotropicPhase>();
     std::shared_ptr<Medium> m;
     if (node.type == "homogeneous") {
         if (!std::dynamic_pointer_cast<const ConstantVolume>(sigma_t))
             throw node.error("a homogeneous medium's sigma_t is one value (a <float>, <rgb>, <spectrum> or constvolume); "
                              "a grid of them makes a heterogeneous medium");
-        m = std::make_shared<HomogeneousMedium>(sigma_t->eval(Vec3(0.f)) * scale, albedo);
+        // Its extinction is sigma_t times the flakes' projected area: the same everywhere only if S is.
+        // (Mitsuba takes its majorant from S at the origin and would be biased wherever S differs.)
+        if (const auto *sggx = dynamic_cast<const SGGXPhase *>(phase.get())) {
+            const auto *grid = dynamic_cast<const GridVolume *>(&sggx->S());
+            if (grid && !grid->uniform())
+                throw node.error("a homogeneous medium's sggx S is the same everywhere (a constvolume, or a grid whose "
+                                 "points all hold one matrix): S that varies makes the extinction vary, a heterogeneous medium");
+        }
+        m = std::make_shared<HomogeneousMedium>(sigma_t->eval(Vec3(0.f)) * scale, albedo, phase);
     } else {
-        m = std::make_shared<HeterogeneousMedium>(sigma_t, albedo, scale);
+        m = std::make_shared<HeterogeneousMedium>(sigma_t, albedo, scale, phase);
     }
     // Each is a float, their product need not be: an infinite extinction would make every free flight 0
     // long and every transmittance NaN.
-    if (const Color bound = m->majorant(); !std::isfinite(bound.x) || !std::isfinite(bound.y) || !std::isfinite(bound.z))
+    const float bound = max_component(sigma_t->max() * scale * Color(phase->max_projected_area()));
+    if (!std::isfinite(bound))
         throw node.error("sigma_t times scale is not a finite number (the largest sigma_t " +
                          std::to_string(sigma_t->max()) + ", scale " + std::to_string(scale) + ")");
-    m->phase = phase ? phase : std::make_shared<IsotropicPhase>();
     m->sample_emitters = node.get_bool("sample_emitters", true);
     warn_unused(node);
     media_[&node] = m;

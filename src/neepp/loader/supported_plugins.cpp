@@ -17,7 +17,7 @@ const std::vector<std::pair<std::string, std::vector<std::string>>> &supported_p
         {"sensor", {"perspective", "orthographic"}},
         {"medium", {"homogeneous", "heterogeneous"}},
         {"volume", {"constvolume", "gridvolume"}},
-        {"phase", {"isotropic", "hg", "rayleigh", "blendphase", "tabphase"}},
+        {"phase", {"isotropic", "hg", "rayleigh", "blendphase", "tabphase", "sggx"}},
         {"film", {"hdrfilm"}},
         {"rfilter", {"box", "tent", "gaussian"}},
         // Mitsuba's stratified and low-discrepancy samplers render with neepp's sobol: the same expected image.

@@ -13,13 +13,13 @@ FreeFlight sample_free_flight(const Medium &medium, const Ray &ray, float t_end,
     r.tmax = std::min(ray.tmax, t_end);
     float t0, t1;
     if (!medium.overlap(r, t0, t1)) return f;
-    const Color majorant = medium.majorant();
+    const Color majorant = medium.majorant(ray.d);
     const float m = majorant[channel];
     const float t = m > 0 ? t0 - std::log(1.f - sampler.next_1d()) / m : kInfinity;
     if (!(t < t1)) return passed_free_flight(medium, ray, t_end);
     f.t = t;
     const Color tr = vexp(-majorant * (t - t0));
-    const MediumCoefficients c = medium.at(r.at(t));
+    const MediumCoefficients c = medium.at(r.at(t), ray.d);
     const Color sigma_n = majorant - c.sigma_t;
     float p_null = 0.f;
     for (int k = 0; k < 3; ++k)
@@ -36,7 +36,7 @@ FreeFlight passed_free_flight(const Medium &medium, const Ray &ray, float t_end)
     Ray r = ray;
     r.tmax = std::min(ray.tmax, t_end);
     float t0, t1;
-    if (medium.overlap(r, t0, t1)) f.f = f.pdf = vexp(-medium.majorant() * (t1 - t0));
+    if (medium.overlap(r, t0, t1)) f.f = f.pdf = vexp(-medium.majorant(ray.d) * (t1 - t0));
     return f;
 }
 

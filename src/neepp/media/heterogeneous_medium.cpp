@@ -6,9 +6,11 @@
 namespace neepp {
 
 HeterogeneousMedium::HeterogeneousMedium(std::shared_ptr<const Volume> sigma_t, std::shared_ptr<const Volume> albedo,
-                                         float scale)
-    : sigma_t_(std::move(sigma_t)), albedo_(std::move(albedo)), scale_(scale), majorant_(scale * sigma_t_->max()),
-      bounds_(sigma_t_->bounds()) {}
+                                         float scale, std::shared_ptr<const PhaseFunction> phase_function)
+    : sigma_t_(std::move(sigma_t)), albedo_(std::move(albedo)), scale_(scale), bounds_(sigma_t_->bounds()) {
+    phase = std::move(phase_function);
+    majorant_ = scale * sigma_t_->max() * phase->max_projected_area();
+}
 
 bool HeterogeneousMedium::overlap(const Ray &ray, float &t0, float &t1) const {
     // The ray against the box, slab by slab.
@@ -27,9 +29,9 @@ bool HeterogeneousMedium::overlap(const Ray &ray, float &t0, float &t1) const {
     return t0 < t1;
 }
 
-MediumCoefficients HeterogeneousMedium::at(const Vec3 &p) const {
+MediumCoefficients HeterogeneousMedium::at(const Vec3 &p, const Vec3 &d) const {
     MediumCoefficients c;
-    c.sigma_t = sigma_t_->eval(p) * scale_;
+    c.sigma_t = sigma_t_->eval(p) * (scale_ * phase->projected_area(p, d));
     c.sigma_s = c.sigma_t * albedo_->eval(p);
     return c;
 }

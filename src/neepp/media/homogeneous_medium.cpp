@@ -4,8 +4,11 @@
 
 namespace neepp {
 
-HomogeneousMedium::HomogeneousMedium(Color sigma_t, std::shared_ptr<const Volume> albedo)
-    : sigma_t_(sigma_t), albedo_(std::move(albedo)) {}
+HomogeneousMedium::HomogeneousMedium(Color sigma_t, std::shared_ptr<const Volume> albedo,
+                                     std::shared_ptr<const PhaseFunction> phase_function)
+    : sigma_t_(sigma_t), albedo_(std::move(albedo)) {
+    phase = std::move(phase_function);
+}
 
 bool HomogeneousMedium::overlap(const Ray &ray, float &t0, float &t1) const {
     t0 = ray.tmin, t1 = ray.tmax;

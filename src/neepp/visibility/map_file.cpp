@@ -47,9 +47,10 @@ uint64_t scene_fingerprint(const Scene &scene) {
         };
         mix("media", 5);
         for (const auto &m : media) {
-            const Color majorant = m->majorant();
+            // Along each axis: a microflake medium's extinction depends on the direction.
+            const Color majorant[3] = {m->majorant(Vec3(1, 0, 0)), m->majorant(Vec3(0, 1, 0)), m->majorant(Vec3(0, 0, 1))};
             const uint8_t flags = uint8_t(m->homogeneous()) | uint8_t(m->sample_emitters << 1);
-            mix(&majorant, sizeof majorant);
+            mix(majorant, sizeof majorant);
             mix(&flags, 1);
         }
         for (const auto &s : scene.shapes()) {

@@ -20,8 +20,8 @@ Color segment_transmittance(const Medium &medium, const Ray &ray, float t_end, i
     float t0, t1;
     if (!medium.overlap(r, t0, t1)) return Color(1.f);
     crossed = true;
-    if (medium.homogeneous()) return vexp(-medium.majorant() * (t1 - t0));
-    const Color majorant = medium.majorant();
+    const Color majorant = medium.majorant(ray.d);
+    if (medium.homogeneous()) return vexp(-majorant * (t1 - t0));
     const float m = majorant[channel];
     if (!(m > 0)) return vexp(-majorant * (t1 - t0));
     Color T(1.f);
@@ -35,7 +35,7 @@ Color segment_transmittance(const Medium &medium, const Ray &ray, float t_end, i
         }
         // A tentative collision, drawn with density m e^{-m step}: the ratio of its weight in each channel.
         ++counters.transmittance_lookups;
-        T *= vexp(-(majorant - Color(m)) * step) * ((majorant - medium.at(r.at(next)).sigma_t) / m);
+        T *= vexp(-(majorant - Color(m)) * step) * ((majorant - medium.at(r.at(next), ray.d).sigma_t) / m);
         if (!(max_component(T) > 0)) return Color(0.f);
         t = next;
     }
