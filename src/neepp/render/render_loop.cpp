@@ -2,6 +2,7 @@
 
 #include <chrono>
 #include <cmath>
+#include <limits>
 #include <memory>
 #include <mutex>
 #include <tbb/enumerable_thread_specific.h>
@@ -204,6 +205,7 @@ private:
     double one_off_s_ = 0;  // seconds of the pass spent on one-off work (PSSMLT's bootstrap)
     double seconds_per_spp_ = 0;
     double last_checkpoint_ = 0, last_snapshot_ = 0;
+    double last_display_ = -std::numeric_limits<double>::infinity();  // the first pass is shown
     RenderResult result_;
 };
 
@@ -274,7 +276,11 @@ RenderResult RenderLoop::run() {
             last_snapshot_ = budget_.elapsed();
             job_.on_snapshot(result_.spp, last_snapshot_, current_image());
         }
-        if (budget_.spp_reached(result_.spp)) { result_.stopped_by = "spp"; break; }
+        if (budget_.spp_reached(result_.spp)) { result_.stopped_by = "spp"; break; }  // the final image is shown below
+        if (job_.on_display && budget_.elapsed() - last_display_ >= job_.display_interval_s) {
+            last_display_ = budget_.elapsed();
+            job_.on_display(current_image());
+        }
         if (job_.on_checkpoint && budget_.elapsed() - last_checkpoint_ >= job_.checkpoint_interval_s) checkpoint(counted());
     }
     // Stopped before its sample count between passes (time, Ctrl-C): what a resume continues from.
@@ -286,6 +292,7 @@ RenderResult RenderLoop::run() {
     result_.counters = counted();
     result_.occlusion_time_s = double(result_.counters.occlusion_ticks) * seconds_per_tick();
     result_.image = current_image();
+    if (job_.on_display) job_.on_display(result_.image);
     if (job_.keep_state) result_.state = make_checkpoint(result_.counters);
     return std::move(result_);
 }
