@@ -206,6 +206,7 @@ private:
     double seconds_per_spp_ = 0;
     double last_checkpoint_ = 0, last_snapshot_ = 0;
     double last_display_ = -std::numeric_limits<double>::infinity();  // the first pass is shown
+    double display_wait_ = 0;
     RenderResult result_;
 };
 
@@ -277,9 +278,13 @@ RenderResult RenderLoop::run() {
             job_.on_snapshot(result_.spp, last_snapshot_, current_image());
         }
         if (budget_.spp_reached(result_.spp)) { result_.stopped_by = "spp"; break; }  // the final image is shown below
-        if (job_.on_display && budget_.elapsed() - last_display_ >= job_.display_interval_s) {
-            last_display_ = budget_.elapsed();
+        if (job_.on_display && budget_.elapsed() - last_display_ >= display_wait_) {
+            const double start = budget_.elapsed();
             job_.on_display(current_image());
+            last_display_ = budget_.elapsed();
+            // Resolving the image is the render's time: a large image is shown less often, so that it costs
+            // at most about 5 % of the render.
+            display_wait_ = std::max(job_.display_interval_s, 20 * (last_display_ - start));
         }
         if (job_.on_checkpoint && budget_.elapsed() - last_checkpoint_ >= job_.checkpoint_interval_s) checkpoint(counted());
     }
