@@ -229,8 +229,6 @@ Rendered run_render(const RenderArgs &a) {
 
     neepp::RenderResult result = neepp::render(*scene, *integrator, job);
     const std::string png = write_images(a, result.image);
-    // The files first, then at most a few seconds for a slow viewer to take the final image.
-    if (display) display->finish(10.0);
     // The last snapshot is the final image (unless the last pass just took it).
     if (!a.snapshots.empty() && result.spp > 0 &&
         (snapshot_index.empty() || snapshot_index.back()["spp"].get<int>() != result.spp))
@@ -239,6 +237,8 @@ Rendered run_render(const RenderArgs &a) {
     nlohmann::json stats = neepp::render_statistics(*scene, *integrator, result, job);
     stats["load_time_s"] = load_s;
     if (!a.stats.empty()) neepp::write_file_atomically(a.stats, stats.dump(2) + "\n");
+    // Every file first, then at most a few seconds for a slow viewer to take the final image.
+    if (display) display->finish(10.0);
     if (!a.quiet)
         fmt::print(stderr, "neepp: {} spp in {:.2f} s ({:.3f} M samples/s, stopped by {}), wrote {} and {}\n", result.spp,
                    result.render_time_s, stats["samples_per_s"].get<double>() * 1e-6, result.stopped_by, a.output, png);
