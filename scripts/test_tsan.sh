@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # ThreadSanitizer over what runs in parallel: the render loop (tiles, the image and splat merges,
-# checkpoints; tests/render) and NEE++'s map (per-thread learning merged between passes, seeding;
-# tests/visibility). TSan must see the thread pool's synchronisation, so oneTBB is first rebuilt with
+# checkpoints; tests/render), NEE++'s map (per-thread learning merged between passes, seeding;
+# tests/visibility) and the display's sending thread (tests/display). TSan must see the thread pool's
+# synchronisation, so oneTBB is first rebuilt with
 # -fsanitize=thread from Debian's own source package (build-tsan/tbb; about 30 s), and neepp's tests are
 # built with clang against it (build-tsan/). Embree is Debian's (see tests/sanitizers/tsan.supp).
 # scripts/test.sh runs it. Usage: scripts/test_tsan.sh
@@ -37,10 +38,13 @@ fi
 cmake -S "$ROOT" -B "$B" -G Ninja -DCMAKE_CXX_COMPILER=clang++ -DCMAKE_BUILD_TYPE=RelWithDebInfo \
   -DNEEPP_PGO= -DNEEPP_MARCH=x86-64-v3 -DNEEPP_SANITIZE=thread \
   -DCMAKE_PREFIX_PATH="$B/tbb" >/dev/null
-cmake --build "$B" --target test_render test_visibility -j"$(nproc)"
+# test_display: TevDisplay's sending thread (--display-server) and the render's hand-over to it.
+cmake --build "$B" --target test_render test_visibility test_display -j"$(nproc)"
 export TSAN_OPTIONS="halt_on_error=1 second_deadlock_stack=1 suppressions=$ROOT/tests/sanitizers/tsan.supp"
-for t in test_render test_visibility; do
-  [[ "$(ldd "$B/$t")" == *"$B/tbb/lib/libtbb"* ]] || { echo "test_tsan: $t does not use the instrumented TBB"; exit 1; }
+for t in test_render test_visibility test_display; do
+  if [[ $t != test_display ]]; then  # the display uses no TBB
+    [[ "$(ldd "$B/$t")" == *"$B/tbb/lib/libtbb"* ]] || { echo "test_tsan: $t does not use the instrumented TBB"; exit 1; }
+  fi
   "$B/$t" --gtest_brief=1
 done
-echo "test_tsan: no data race in the render loop or the visibility map's tests"
+echo "test_tsan: no data race in the render loop's, the visibility map's or the display's tests"

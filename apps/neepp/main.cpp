@@ -7,11 +7,13 @@
 #include <cstring>
 #include <filesystem>
 #include <iostream>
+#include <memory>
 #include <optional>
 #include <stdexcept>
 #include <unistd.h>
 #include <CLI/CLI.hpp>
 #include <fmt/core.h>
+#include "neepp/display/tev_display.h"
 #include "neepp/integrators/factory.h"
 #include "neepp/integrators/option_table.h"
 #include "neepp/io/atomic_file.h"
@@ -51,6 +53,7 @@ std::pair<std::string, std::string> split_key_value(const std::string &s, const 
 
 struct RenderArgs {
     std::string scene, output = "render.exr", integrator, stats, sampler, rfilter, visibility_map, snapshots;
+    std::string display_server;  // HOST:PORT of a tev to show the render in as it converges
     int spp = 0, threads = 0;
     double time_s = 0, checkpoint_s = 0;
     bool resume = false;
@@ -214,6 +217,16 @@ Rendered run_render(const RenderArgs &a) {
                    load_s, name,
                    job.spp > 0 ? fmt::format("{} spp", job.spp) : fmt::format("{} s", job.time_limit_s));
 
+    // --display-server: the image after each pass (a few a second at most) and the final one, sent by a
+    // thread of the display's own; the image is named as the output file, so a render of the same file
+    // again replaces it in tev.
+    std::unique_ptr<neepp::TevDisplay> display;
+    if (!a.display_server.empty()) {
+        display = std::make_unique<neepp::TevDisplay>(neepp::parse_server_address(a.display_server), a.output,
+                                                      [](const std::string &w) { fmt::print(stderr, "neepp: warning: {}\n", w); });
+        job.on_display = [&](neepp::Image image) { display->show(std::move(image)); };
+    }
+
     neepp::RenderResult result = neepp::render(*scene, *integrator, job);
     const std::string png = write_images(a, result.image);
     // The last snapshot is the final image (unless the last pass just took it).
@@ -224,6 +237,8 @@ Rendered run_render(const RenderArgs &a) {
     nlohmann::json stats = neepp::render_statistics(*scene, *integrator, result, job);
     stats["load_time_s"] = load_s;
     if (!a.stats.empty()) neepp::write_file_atomically(a.stats, stats.dump(2) + "\n");
+    // Every file first, then at most a few seconds for a slow viewer to take the final image.
+    if (display) display->finish(10.0);
     if (!a.quiet)
         fmt::print(stderr, "neepp: {} spp in {:.2f} s ({:.3f} M samples/s, stopped by {}), wrote {} and {}\n", result.spp,
                    result.render_time_s, stats["samples_per_s"].get<double>() * 1e-6, result.stopped_by, a.output, png);
@@ -478,6 +493,22 @@ int main(int argc, char **argv) {
     render->add_flag("--resume", ra.resume,
                      "Continue the render saved in OUTPUT.checkpoint (same scene, options and seed) to the same image an "
                      "uninterrupted render gives");
+    render->add_option("--display-server", ra.display_server,
+                       "Show the render in tev (the HDR viewer) as it converges, the tev listening at HOST:PORT "
+                       "(tev's default 127.0.0.1:14158): the image after each pass, a few times a second at most, "
+                       "and the final one. A viewer that is absent, slow or goes away costs a warning, never the "
+                       "render, and the image written is the same")
+        ->type_name("HOST:PORT")
+        ->check(CLI::Validator(
+            [](std::string &s) {
+                try {
+                    neepp::parse_server_address(s);
+                    return std::string();
+                } catch (const std::invalid_argument &e) {
+                    return std::string(e.what());
+                }
+            },
+            ""));  // no description: the type name already says HOST:PORT
     render->add_flag("-q,--quiet", ra.quiet, "No progress bar or messages");
     std::string ray_address;
     int workers = 2;

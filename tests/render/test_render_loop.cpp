@@ -99,6 +99,28 @@ TEST(RenderLoop, CancelStopsEarlyWithTheImageSoFar) {
     EXPECT_GT(pixel_statistics(r.image, 0).mean, 0.0);
 }
 
+TEST(RenderLoop, ShowsTheImageBetweenPassesAndTheFinalOneWithoutChangingIt) {
+    auto scene = demo_scene(32, 18);
+    RenderJob job;
+    job.spp = 37;
+    auto integ = make_integrator("path", Options(OptionMap{{"shadow_rays", "nee"}}));
+    const RenderResult plain = render(*scene, *integ, job);
+    ASSERT_EQ(plain.passes, 3);  // 1 + 32 + 4 spp
+    for (double interval : {0.0, 1e9}) {
+        SCOPED_TRACE(interval);
+        std::vector<Image> shown;
+        job.display_interval_s = interval;
+        job.on_display = [&](Image image) { shown.push_back(std::move(image)); };
+        const RenderResult r = render(*scene, *integ, job);
+        // Every pass but the last (whose image is the final one), or only the first when the interval is
+        // long; then the final image.
+        ASSERT_EQ(shown.size(), interval == 0 ? 3u : 2u);
+        EXPECT_TRUE(shown.back().data == r.image.data);
+        EXPECT_FALSE(shown.front().data == r.image.data);  // one pass: fewer samples
+        EXPECT_TRUE(r.image.data == plain.image.data);     // the hook only reads
+    }
+}
+
 TEST(RenderLoop, NeedsASampleCountOrATimeLimit) {
     auto scene = demo_scene(8, 8);
     auto integ = make_integrator("path", Options());

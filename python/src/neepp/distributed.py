@@ -321,11 +321,11 @@ def main(argv=None) -> int:
     ap.add_argument("-q", "--quiet", action="store_true")
     ap.add_argument("--ray", nargs="?", const="", default="", metavar="ADDRESS")
     ap.add_argument("--workers", type=int, default=2)
-    for unsupported in ["--checkpoint", "--snapshots", "--visibility-map", "--rfilter"]:
+    for unsupported in ["--checkpoint", "--snapshots", "--visibility-map", "--rfilter", "--display-server"]:
         ap.add_argument(unsupported, help=argparse.SUPPRESS)
     ap.add_argument("--resume", action="store_true", help=argparse.SUPPRESS)
     a = ap.parse_args(argv)
-    for name in ["checkpoint", "snapshots", "visibility_map", "rfilter"]:
+    for name in ["checkpoint", "snapshots", "visibility_map", "rfilter", "display_server"]:
         if getattr(a, name) is not None:
             ap.error(f"--{name.replace('_', '-')} is not available with --ray")
     if a.resume:

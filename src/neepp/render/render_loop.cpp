@@ -2,6 +2,7 @@
 
 #include <chrono>
 #include <cmath>
+#include <limits>
 #include <memory>
 #include <mutex>
 #include <tbb/enumerable_thread_specific.h>
@@ -204,6 +205,8 @@ private:
     double one_off_s_ = 0;  // seconds of the pass spent on one-off work (PSSMLT's bootstrap)
     double seconds_per_spp_ = 0;
     double last_checkpoint_ = 0, last_snapshot_ = 0;
+    double last_display_ = -std::numeric_limits<double>::infinity();  // the first pass is shown
+    double display_wait_ = 0;
     RenderResult result_;
 };
 
@@ -274,7 +277,15 @@ RenderResult RenderLoop::run() {
             last_snapshot_ = budget_.elapsed();
             job_.on_snapshot(result_.spp, last_snapshot_, current_image());
         }
-        if (budget_.spp_reached(result_.spp)) { result_.stopped_by = "spp"; break; }
+        if (budget_.spp_reached(result_.spp)) { result_.stopped_by = "spp"; break; }  // the final image is shown below
+        if (job_.on_display && budget_.elapsed() - last_display_ >= display_wait_) {
+            const double start = budget_.elapsed();
+            job_.on_display(current_image());
+            last_display_ = budget_.elapsed();
+            // Resolving the image is the render's time: a large image is shown less often, so that it costs
+            // at most about 5 % of the render.
+            display_wait_ = std::max(job_.display_interval_s, 20 * (last_display_ - start));
+        }
         if (job_.on_checkpoint && budget_.elapsed() - last_checkpoint_ >= job_.checkpoint_interval_s) checkpoint(counted());
     }
     // Stopped before its sample count between passes (time, Ctrl-C): what a resume continues from.
@@ -286,6 +297,7 @@ RenderResult RenderLoop::run() {
     result_.counters = counted();
     result_.occlusion_time_s = double(result_.counters.occlusion_ticks) * seconds_per_tick();
     result_.image = current_image();
+    if (job_.on_display) job_.on_display(result_.image);
     if (job_.keep_state) result_.state = make_checkpoint(result_.counters);
     return std::move(result_);
 }

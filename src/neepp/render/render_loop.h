@@ -39,6 +39,14 @@ struct RenderJob {
     // pass that ends once the render time has grown snapshot_growth times since the last snapshot.
     double snapshot_growth = 1.5;
     std::function<void(int spp, double render_time_s, const Image &)> on_snapshot;
+    // A live view of the image as it converges (a viewer such as tev, neepp render --display-server):
+    // after a pass that ends once display_interval_s has passed since the last (longer for an image so
+    // large that resolving it would cost more than about 5 % of the render), on_display gets the image so
+    // far, and at the end the final image. It runs on the render's thread between passes, so it must
+    // return at once (TevDisplay hands the image to a thread of its own); it only reads, so the image is
+    // the same with it or without.
+    double display_interval_s = 0.25;
+    std::function<void(Image)> on_display;
     // Distributed rendering splits an image by sample index: this render's samples are first_sample ..
     // spp - 1 (the image holds spp - first_sample of them), what the integrator learns starts from
     // integrator_state (what renders of earlier ranges learned, restored right after prepare) when given,
