@@ -2,8 +2,9 @@
 // scattering coefficients at a point and a majorant that bounds the extinction, with which free-flight
 // distances are sampled (delta tracking) and transmittance estimated (ratio tracking); a phase function
 // says how light scatters at a point of it. Both take the direction of travel too: a medium of oriented
-// microflakes (the sggx phase function) is denser to light crossing its flakes than to light grazing them. Media fill the insides and outsides of shapes that declare
-// them (Shape::interior, Shape::exterior) and the space around a camera that sits in one.
+// microflakes (the sggx phase function) is denser to light crossing its flakes than to light grazing them.
+// Media fill the insides and outsides of shapes that declare them (Shape::interior, Shape::exterior) and
+// the space around a camera that sits in one.
 #pragma once
 #include <memory>
 #include "neepp/math/bbox.h"
