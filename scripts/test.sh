@@ -36,4 +36,4 @@ ctest --test-dir "$ROOT/build" --output-on-failure -j2
 # ThreadSanitizer over the render loop's and the visibility map's tests, with TBB rebuilt for it.
 "$ROOT/scripts/test_tsan.sh"
 "$ROOT/scripts/fuzz.sh" 10
-cd "$ROOT" && NEEPP_BIN="$ROOT/build/neepp" "$ROOT/.venv/bin/python" -m pytest tests/python -q -rs
+cd "$ROOT" && NEEPP_BIN="$ROOT/build/neepp" "$ROOT/.venv/bin/python" -m pytest tests/python -q -rs --durations=30
