@@ -61,13 +61,9 @@ private:
 }  // namespace
 
 std::vector<std::string> channel_names(int channels) {
-    switch (channels) {
-    case 1: return {"Y"};
-    case 2: return {"Y", "A"};
-    case 3: return {"R", "G", "B"};
-    case 4: return {"R", "G", "B", "A"};
-    }
-    throw std::invalid_argument("tev: an image has 1 to 4 channels, not " + std::to_string(channels));
+    std::vector<std::string> names = neepp::channel_names(channels);  // the EXR's, so tev shows what is written
+    if (names.empty()) throw std::invalid_argument("tev: an image has 1 to 4 channels, not " + std::to_string(channels));
+    return names;
 }
 
 std::vector<uint8_t> create_image_packet(const std::string &name, bool grab_focus, int width, int height,

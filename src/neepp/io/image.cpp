@@ -32,17 +32,6 @@ namespace {
     throw std::runtime_error(fmt::format("image '{}': {}", path, what));
 }
 
-// EXR channel names per channel count, alpha last (Image's layout).
-std::vector<std::string> channel_names(int channels) {
-    switch (channels) {
-        case 1: return {"Y"};
-        case 2: return {"Y", "A"};
-        case 3: return {"R", "G", "B"};
-        case 4: return {"R", "G", "B", "A"};
-        default: return {};
-    }
-}
-
 enum class FileKind { Exr, Jpeg, Other };
 
 FileKind sniff(const std::string &path) {
@@ -244,6 +233,16 @@ Image read_image(const std::string &path) {
     if (kind == FileKind::Exr) return read_exr(path);
     if (std::optional<ImageBytes> bytes = read_bytes(path, kind)) return image_from_bytes(*bytes);
     return read_stb(path);
+}
+
+std::vector<std::string> channel_names(int channels) {
+    switch (channels) {
+        case 1: return {"Y"};
+        case 2: return {"Y", "A"};
+        case 3: return {"R", "G", "B"};
+        case 4: return {"R", "G", "B", "A"};
+        default: return {};
+    }
 }
 
 void write_exr(const std::string &path, const Image &img, bool half) {

@@ -50,6 +50,9 @@ std::optional<ImageBytes> read_image_bytes(const std::string &path);
 // Writes the image to OpenEXR (half or float; channels named Y, YA, RGB or RGBA). Throws on failure.
 // Both writers replace the file atomically (see atomic_file.h): never a half-written image.
 void write_exr(const std::string &path, const Image &img, bool half = false);
+// The channel names of an image of 1 to 4 channels, alpha last (Y, YA, RGB, RGBA), as write_exr and the
+// tev display name them; empty for another count.
+std::vector<std::string> channel_names(int channels);
 // Writes an 8-bit sRGB PNG after exposure scaling and clamping (no other tonemapping). Alpha, if
 // present, is written linearly and unscaled. Throws on failure.
 void write_png_srgb(const std::string &path, const Image &img, float exposure = 1.f);
