@@ -224,7 +224,7 @@ Rendered run_render(const RenderArgs &a) {
     if (!a.display_server.empty()) {
         display = std::make_unique<neepp::TevDisplay>(neepp::parse_server_address(a.display_server), a.output,
                                                       [](const std::string &w) { fmt::print(stderr, "neepp: warning: {}\n", w); });
-        job.on_display = [&](neepp::Image image) { display->show(std::move(image)); };
+        job.on_display = [&](neepp::DisplayFrame frame) { display->show(std::move(frame.image)); };
     }
 
     neepp::RenderResult result = neepp::render(*scene, *integrator, job);
