@@ -224,7 +224,7 @@ Rendered run_render(const RenderArgs &a) {
     if (!a.display_server.empty()) {
         display = std::make_unique<neepp::TevDisplay>(neepp::parse_server_address(a.display_server), a.output,
                                                       [](const std::string &w) { fmt::print(stderr, "neepp: warning: {}\n", w); });
-        job.on_display = [&](neepp::Image image) { display->show(std::move(image)); };
+        job.on_display = [&](neepp::DisplayFrame frame) { display->show(std::move(frame.image)); };
     }
 
     neepp::RenderResult result = neepp::render(*scene, *integrator, job);
@@ -441,6 +441,14 @@ void run_demo(const std::string &dir, int spp, bool quiet) {
     exec_python("neepp compare", words);
 }
 
+// `neepp view` is neepp_tools.view (Python: the web server, the page, and the renders through the neepp
+// package), given its arguments as they were typed.
+[[noreturn]] void run_view(const std::vector<std::string> &args) {
+    std::vector<std::string> words = {"-m", "neepp_tools.view"};
+    words.insert(words.end(), args.begin(), args.end());
+    exec_python("neepp view", words);
+}
+
 // `neepp render --ray [ADDRESS] --workers N` is neepp.distributed's command line (the Python package),
 // given the render's arguments as they were typed.
 [[noreturn]] void run_distributed(int argc, char **argv) {
@@ -541,9 +549,16 @@ int main(int argc, char **argv) {
                                                   "--time S [--reference REF.exr] -o DIR (neepp compare --help for all)");
     compare->prefix_command();  // everything after it is the Python tool's
     compare->set_help_flag();
+    auto *view = app.add_subcommand("view", "Render a scene interactively in a local web page: move the camera, switch "
+                                            "the integrator's options, watch the image converge and NEE++'s map keep "
+                                            "learning: neepp view SCENE.xml [-D name=value] [--integrator NAME] "
+                                            "[-I key=value] [--port N] [--open] (neepp view --help for all)");
+    view->prefix_command();  // everything after it is the Python tool's
+    view->set_help_flag();
 
     CLI11_PARSE(app, argc, argv);
     if (*compare) run_compare(compare->remaining());
+    if (*view) run_view(view->remaining());
     if (*render && (render->count("--ray") > 0 || render->count("--workers") > 0)) run_distributed(argc, argv);
     std::signal(SIGINT, on_stop_signal);
     std::signal(SIGTERM, on_stop_signal);

@@ -19,14 +19,14 @@
 
 namespace neepp::python {
 
-namespace {
-
 std::unique_ptr<Integrator> scene_integrator(const Scene &scene, const std::string &name,
                                              const std::map<std::string, std::string> &overrides) {
     Options options(scene.settings.integrator_options);
     for (const auto &[key, value] : overrides) options.set(key, value);
     return make_integrator(name.empty() ? scene.settings.integrator : name, options);
 }
+
+namespace {
 
 RenderJob make_job(const Scene &scene, int spp, double time_s, uint64_t seed, int threads, const std::string &sampler) {
     RenderJob job;

@@ -49,3 +49,20 @@ def require(command: str, required: dict[str, str], any_of: list[dict[str, str]]
 # mitsuba or OpenEXR to read EXR files (NVIDIA FLIP is optional: without it the page has no FLIP column).
 COMPARE_REQUIRED = {"numpy": "numpy", "PIL": "pillow", "matplotlib": "matplotlib"}
 COMPARE_ANY_OF = [{"mitsuba": "mitsuba", "OpenEXR": "openexr"}]
+
+# What `neepp view` imports: numpy, and aiohttp for its web server; it renders through the neepp package
+# itself (require_package).
+VIEW_REQUIRED = {"numpy": "numpy", "aiohttp": "aiohttp"}
+
+
+def require_package(command: str) -> None:
+    """Exits (status 1) with the command that installs the neepp package into this Python, when it lacks it:
+    scripts/setup_python.sh installs the modules the tools import, not the package built from the checkout."""
+    if _present("neepp._neepp"):
+        return
+    print("\n".join([
+        f"neepp: error: {command} renders through the neepp Python package, which {sys.executable} lacks.",
+        "Build and install it from this checkout (scripts/test.sh does it too) with:",
+        f"    {sys.executable} -m pip install --no-build-isolation {REPO_ROOT}",
+    ]), file=sys.stderr)
+    sys.exit(1)

@@ -108,17 +108,71 @@ TEST(RenderLoop, ShowsTheImageBetweenPassesAndTheFinalOneWithoutChangingIt) {
     ASSERT_EQ(plain.passes, 3);  // 1 + 32 + 4 spp
     for (double interval : {0.0, 1e9}) {
         SCOPED_TRACE(interval);
-        std::vector<Image> shown;
+        std::vector<DisplayFrame> shown;
         job.display_interval_s = interval;
-        job.on_display = [&](Image image) { shown.push_back(std::move(image)); };
+        job.on_display = [&](DisplayFrame frame) { shown.push_back(std::move(frame)); };
         const RenderResult r = render(*scene, *integ, job);
         // Every pass but the last (whose image is the final one), or only the first when the interval is
         // long; then the final image.
         ASSERT_EQ(shown.size(), interval == 0 ? 3u : 2u);
-        EXPECT_TRUE(shown.back().data == r.image.data);
-        EXPECT_FALSE(shown.front().data == r.image.data);  // one pass: fewer samples
-        EXPECT_TRUE(r.image.data == plain.image.data);     // the hook only reads
+        EXPECT_TRUE(shown.back().image.data == r.image.data);
+        EXPECT_FALSE(shown.front().image.data == r.image.data);  // one pass: fewer samples
+        EXPECT_TRUE(r.image.data == plain.image.data);           // the hook only reads
+        // Each frame says what made it: the samples so far and their counters, growing to the result's.
+        EXPECT_EQ(shown.front().spp, 1);
+        EXPECT_FALSE(shown.front().final);
+        EXPECT_GT(shown.front().counters.rays, 0u);
+        EXPECT_LT(shown.front().counters.rays, r.counters.rays);
+        EXPECT_TRUE(shown.back().final);
+        EXPECT_EQ(shown.back().spp, r.spp);
+        EXPECT_EQ(shown.back().counters.rays, r.counters.rays);
+        EXPECT_DOUBLE_EQ(shown.back().render_time_s, r.render_time_s);
+        if (interval == 0) {
+            EXPECT_EQ(shown[1].spp, 33);
+        }
     }
+}
+
+TEST(RenderLoop, AnInteractiveViewGetsPassesOfItsDisplayInterval) {
+    // neepp view shows the image a few times a second: a pass longer than that would hold it back. With a
+    // cap far below a pass's time, every pass is one sample per pixel; the image is a full render's.
+    auto scene = demo_scene(32, 18);
+    RenderJob job;
+    job.spp = 6;
+    auto integ = make_integrator("path", Options(OptionMap{{"shadow_rays", "nee"}}));
+    const RenderResult plain = render(*scene, *integ, job);
+    EXPECT_EQ(plain.passes, 2);  // 1 + 5
+    job.max_pass_s = 1e-9;
+    const RenderResult capped = render(*scene, *integ, job);
+    EXPECT_EQ(capped.passes, 6);
+    EXPECT_EQ(capped.spp, 6);
+    job.max_pass_s = 1e9;  // a cap longer than any pass changes nothing
+    EXPECT_EQ(render(*scene, *integ, job).passes, 2);
+}
+
+TEST(RenderLoop, APreparedIntegratorKeepsWhatItLearned) {
+    // neepp view restarts the image at each camera move with the integrator prepared once: NEE++'s map and
+    // its totals carry over and keep growing, where a render that prepares again starts them anew.
+    auto scene = demo_scene(32, 18);
+    RenderJob job;
+    job.spp = 8;
+    auto merged_passes = [](const Integrator &i) {
+        return i.statistics()["shadow_rays"]["roulette"]["passes_merged"].get<uint64_t>();
+    };
+    auto integ = make_integrator("path", Options(OptionMap{{"shadow_rays", "neepp"}}));
+    const RenderResult first = render(*scene, *integ, job);
+    const uint64_t after_first = merged_passes(*integ);
+    ASSERT_EQ(after_first, uint64_t(first.passes));
+    scene->camera.to_world = Transform::translate(Vec3(0.05f, 0.f, 0.f)) * scene->camera.to_world;  // a move
+    scene->camera.finalize();
+    job.prepared = true;
+    const RenderResult kept = render(*scene, *integ, job);
+    EXPECT_EQ(merged_passes(*integ), after_first + uint64_t(kept.passes));
+    EXPECT_EQ(kept.spp, 8);
+    EXPECT_GT(pixel_statistics(kept.image, 0).mean, 0.0);
+    job.prepared = false;
+    const RenderResult fresh = render(*scene, *integ, job);
+    EXPECT_EQ(merged_passes(*integ), uint64_t(fresh.passes));
 }
 
 TEST(RenderLoop, NeedsASampleCountOrATimeLimit) {

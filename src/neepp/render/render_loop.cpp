@@ -1,5 +1,6 @@
 #include "neepp/render/render_loop.h"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <limits>
@@ -44,9 +45,13 @@ std::vector<Tile> make_tiles(int width, int height, int size) {
 // each packet of 16 rays the path tracer traces then starts from one pixel, and coherent rays are cheaper
 // to trace. Under a time limit a pass is sized to end before the deadline by the speed of the last
 // (with a 5% margin): a pass is all or nothing, so one cut off by the deadline would be work thrown away.
-int pass_size(int done, int target, double seconds_per_spp, double remaining_s, bool timed, bool learns) {
+// An interactive view (RenderJob::max_pass_s) caps a pass at what the last one's speed renders in that
+// time, and at one sample per pixel.
+int pass_size(int done, int target, double seconds_per_spp, double remaining_s, bool timed, bool learns,
+              double max_pass_s) {
     constexpr int kMaxPass = 32;
     int size = done == 0 ? 1 : learns ? std::min(done, kMaxPass) : kMaxPass;
+    if (max_pass_s > 0 && seconds_per_spp > 0) size = int(std::clamp(std::floor(max_pass_s / seconds_per_spp), 1.0, double(size)));
     if (target > 0) size = std::min(size, target - done);
     if (timed && seconds_per_spp > 0) {
         double affordable = std::floor(0.95 * remaining_s / seconds_per_spp);
@@ -99,7 +104,7 @@ public:
     double remaining() const { return timed() ? job_.time_limit_s - elapsed() : 0; }
     bool spp_reached(int spp) const { return job_.spp > 0 && spp >= job_.spp; }
     int next_pass_size(int done, double seconds_per_spp, bool learns) const {
-        return pass_size(done, job_.spp, seconds_per_spp, remaining(), timed(), learns);
+        return pass_size(done, job_.spp, seconds_per_spp, remaining(), timed(), learns, job_.max_pass_s);
     }
     // A time limit cuts a pass short only when it overruns badly (the first pass, whose speed was unknown,
     // or a wrong estimate): otherwise the pass, sized to fit, is finished.
@@ -231,7 +236,7 @@ RenderLoop::RenderLoop(const Scene &scene, Integrator &integrator, const RenderJ
 RenderResult RenderLoop::run() {
     ProgressBar bar([this] { return budget_.fraction(spp_done_now_.load() + double(samples_done_.load()) / (double(W_) * H_)); },
                     job_.progress, job_.on_progress);
-    integrator_.prepare(scene_);
+    if (!job_.prepared) integrator_.prepare(scene_);
     if (job_.resume) {  // continue the render a checkpoint holds
         const RenderCheckpoint &c = *job_.resume;
         if (splatting_ != !c.splat_sums.empty()) throw std::invalid_argument("resume: the checkpoint's splats do not match the integrator");
@@ -280,7 +285,7 @@ RenderResult RenderLoop::run() {
         if (budget_.spp_reached(result_.spp)) { result_.stopped_by = "spp"; break; }  // the final image is shown below
         if (job_.on_display && budget_.elapsed() - last_display_ >= display_wait_) {
             const double start = budget_.elapsed();
-            job_.on_display(current_image());
+            job_.on_display(DisplayFrame{current_image(), result_.spp, budget_.elapsed(), counted(), false});
             last_display_ = budget_.elapsed();
             // Resolving the image is the render's time: a large image is shown less often, so that it costs
             // at most about 5 % of the render.
@@ -297,7 +302,7 @@ RenderResult RenderLoop::run() {
     result_.counters = counted();
     result_.occlusion_time_s = double(result_.counters.occlusion_ticks) * seconds_per_tick();
     result_.image = current_image();
-    if (job_.on_display) job_.on_display(result_.image);
+    if (job_.on_display) job_.on_display(DisplayFrame{result_.image, result_.spp, result_.render_time_s, result_.counters, true});
     if (job_.keep_state) result_.state = make_checkpoint(result_.counters);
     return std::move(result_);
 }

@@ -16,6 +16,15 @@ namespace neepp {
 class Scene;
 class Integrator;
 
+// What a live view of the render is shown (RenderJob::on_display): the image so far and what made it.
+struct DisplayFrame {
+    Image image;
+    int spp = 0;                // samples per pixel in the image
+    double render_time_s = 0;
+    RenderCounters counters;    // of the samples in the image
+    bool final = false;         // the render's last image
+};
+
 struct RenderJob {
     int spp = 16;                 // target samples per pixel; 0 = as many as time_limit_s allows
     double time_limit_s = 0;      // 0 = no limit
@@ -39,14 +48,23 @@ struct RenderJob {
     // pass that ends once the render time has grown snapshot_growth times since the last snapshot.
     double snapshot_growth = 1.5;
     std::function<void(int spp, double render_time_s, const Image &)> on_snapshot;
-    // A live view of the image as it converges (a viewer such as tev, neepp render --display-server):
-    // after a pass that ends once display_interval_s has passed since the last (longer for an image so
-    // large that resolving it would cost more than about 5 % of the render), on_display gets the image so
-    // far, and at the end the final image. It runs on the render's thread between passes, so it must
-    // return at once (TevDisplay hands the image to a thread of its own); it only reads, so the image is
-    // the same with it or without.
+    // A live view of the image as it converges (a viewer such as tev, neepp render --display-server, or
+    // neepp view): after a pass that ends once display_interval_s has passed since the last (longer for an
+    // image so large that resolving it would cost more than about 5 % of the render), on_display gets the
+    // image so far with its sample count and counters, and at the end the final image. It runs on the
+    // render's thread between passes, so it must return at once (TevDisplay hands the image to a thread of
+    // its own); it only reads, so the image is the same with it or without.
     double display_interval_s = 0.25;
-    std::function<void(Image)> on_display;
+    std::function<void(DisplayFrame)> on_display;
+    // 0: passes as large as the render loop likes (up to 32 spp). An interactive view (neepp view) sets
+    // about its display interval: each pass then takes about that long at the last pass's speed (at least
+    // one sample per pixel), so that the image can be shown that often.
+    double max_pass_s = 0;
+    // The integrator was prepared by an earlier render of this scene and continues from what it has
+    // learned since, instead of being prepared afresh (neepp view: a camera move restarts the image, not
+    // NEE++'s visibility map, which belongs to the scene and keeps learning). The caller keeps the scene
+    // as the integrator was prepared for, but for the camera.
+    bool prepared = false;
     // Distributed rendering splits an image by sample index: this render's samples are first_sample ..
     // spp - 1 (the image holds spp - first_sample of them), what the integrator learns starts from
     // integrator_state (what renders of earlier ranges learned, restored right after prepare) when given,

@@ -1,0 +1,287 @@
+// neepp view's page: shows the frames the server sends (linear RGB, tonemapped here at the chosen
+// exposure), turns mouse and keys into camera commands, and the option menus into option changes. The
+// server holds the view (camera, integrator): every page open on it shows the same one.
+"use strict";
+
+const $ = (id) => document.getElementById(id);
+const canvas = $("image");
+const ctx = canvas.getContext("2d");
+let ws = null;
+let state = null;           // the server's latest "state" message
+let frame = null;           // {header, pixels: Float32Array} of the newest frame
+const listeners = [];       // the self-test's waits: functions called with each frame
+
+// ---- frames -------------------------------------------------------------------------------------------
+
+function decodeFrame(buffer) {
+  const view = new DataView(buffer);
+  const n = view.getUint32(0, true);
+  const header = JSON.parse(new TextDecoder().decode(new Uint8Array(buffer, 4, n)));
+  const pixels = new Float32Array(buffer, 4 + n, header.width * header.height * 3);
+  return { header, pixels };
+}
+
+// sRGB encoding of a linear value in [0, 1].
+function srgb(v) {
+  return v <= 0.0031308 ? 12.92 * v : 1.055 * Math.pow(v, 1 / 2.4) - 0.055;
+}
+
+function draw() {
+  if (!frame) return;
+  const { width, height } = frame.header;
+  if (canvas.width !== width || canvas.height !== height) {
+    canvas.width = width;
+    canvas.height = height;
+  }
+  // The coarse first frame is drawn at the full image's size, enlarged.
+  if (state) canvas.style.width = state.width + "px";
+  const scale = Math.pow(2, Number($("exposure").value));
+  const img = ctx.createImageData(width, height);
+  const src = frame.pixels, dst = img.data;
+  for (let i = 0, j = 0; i < src.length; i += 3, j += 4) {
+    dst[j] = 255 * srgb(Math.min(1, Math.max(0, src[i] * scale))) + 0.5;
+    dst[j + 1] = 255 * srgb(Math.min(1, Math.max(0, src[i + 1] * scale))) + 0.5;
+    dst[j + 2] = 255 * srgb(Math.min(1, Math.max(0, src[i + 2] * scale))) + 0.5;
+    dst[j + 3] = 255;
+  }
+  ctx.putImageData(img, 0, 0);
+}
+
+function formatCount(n) {
+  if (n >= 1e9) return (n / 1e9).toFixed(2) + " G";
+  if (n >= 1e6) return (n / 1e6).toFixed(2) + " M";
+  if (n >= 1e3) return (n / 1e3).toFixed(1) + " k";
+  return String(n);
+}
+
+function percent(part, whole) {
+  return whole > 0 ? " (" + (100 * part / whole).toFixed(1) + " %)" : "";
+}
+
+function showStats(h) {
+  const tested = h.shadow_rays + h.shadow_rays_skipped;
+  const text = {
+    view: h.view + (h.coarse ? " (coarse)" : ""),
+    spp: String(h.spp),
+    samples_per_s: formatCount(h.samples_per_s),
+    render_time_s: h.render_time_s.toFixed(2) + " s",
+    rays: formatCount(h.rays),
+    shadow_rays: formatCount(h.shadow_rays),
+    shadow_rays_skipped: formatCount(h.shadow_rays_skipped) + percent(h.shadow_rays_skipped, tested),
+    shadow_rays_occluded: formatCount(h.shadow_rays_occluded) + percent(h.shadow_rays_occluded, h.shadow_rays),
+    fov: h.fov.toFixed(1) + "°",
+  };
+  for (const td of document.querySelectorAll("#stats td")) {
+    const key = td.dataset.key;
+    td.textContent = text[key];
+    td.dataset.value = String(h[key]);
+  }
+}
+
+// ---- options ------------------------------------------------------------------------------------------
+
+function fill(select, names, value) {
+  select.replaceChildren(...names.map((n) => new Option(n, n)));
+  if (value !== undefined && !names.includes(value)) select.append(new Option(value, value));
+  if (value !== undefined) select.value = value;
+}
+
+function integratorDoc(name) {
+  return state.catalog.integrators.find((d) => d.name === name);
+}
+
+// An option's value as the render uses it: the page's or the command line's, else the scene's, else the
+// integrator's default.
+function effective(key) {
+  if (key in state.options) return state.options[key];
+  if (key in state.scene_options) return state.scene_options[key];
+  const doc = integratorDoc(state.integrator);
+  const o = doc && doc.options.find((x) => x.name === key);
+  return o ? o.default : undefined;
+}
+
+function showState(s) {
+  state = s;
+  $("scene").textContent = s.scene + " (" + s.width + "×" + s.height + ")";
+  fill($("integrator"), s.catalog.integrators.map((d) => d.name), s.integrator);
+  fill($("shadow_rays"), s.catalog.shadow_ray_policies.map((p) => p[0]), effective("shadow_rays"));
+  fill($("light_sampler"), s.catalog.light_samplers, effective("light_sampler"));
+  const doc = integratorDoc(s.integrator);
+  for (const key of ["shadow_rays", "light_sampler"])
+    $(key).disabled = !(doc && doc.options.some((o) => o.name === key));
+  draw();
+}
+
+function sendOptions() {
+  const integrator = $("integrator").value;
+  const doc = integratorDoc(integrator);
+  const options = {};
+  for (const key of ["shadow_rays", "light_sampler"]) {
+    if (doc && doc.options.some((o) => o.name === key) && !$(key).disabled) options[key] = $(key).value;
+  }
+  $("error").textContent = "";
+  send({ type: "options", integrator, options });
+}
+
+// ---- the server ---------------------------------------------------------------------------------------
+
+function send(msg) {
+  if (ws && ws.readyState === WebSocket.OPEN) ws.send(JSON.stringify(msg));
+}
+
+function connect() {
+  ws = new WebSocket("ws://" + location.host + "/ws");
+  ws.binaryType = "arraybuffer";
+  ws.onopen = () => { $("connection").textContent = "connected"; };
+  ws.onclose = () => {
+    $("connection").textContent = "disconnected: is neepp view still running? (reload to reconnect)";
+  };
+  ws.onmessage = (event) => {
+    if (event.data instanceof ArrayBuffer) {
+      frame = decodeFrame(event.data);
+      draw();
+      showStats(frame.header);
+      for (const f of listeners.slice()) f(frame.header);
+      return;
+    }
+    const msg = JSON.parse(event.data);
+    if (msg.type === "state") showState(msg);
+    else if (msg.type === "error") $("error").textContent = msg.message;
+    else if (msg.type === "saved") $("saved").textContent = "saved " + msg.files.join(", ");
+  };
+}
+
+// ---- mouse and keys -----------------------------------------------------------------------------------
+
+// Movements add up here and go to the server at most every 30 ms: one restart per batch, not per event.
+const pending = { orbit: [0, 0], pan: [0, 0], dolly: 0, zoom: 0 };
+let flushTimer = null;
+
+function queue(apply) {
+  apply(pending);
+  if (flushTimer === null) flushTimer = setTimeout(flush, 30);
+}
+
+function flush() {
+  flushTimer = null;
+  if (pending.orbit[0] || pending.orbit[1]) send({ type: "orbit", dx: pending.orbit[0], dy: pending.orbit[1] });
+  if (pending.pan[0] || pending.pan[1]) send({ type: "pan", dx: pending.pan[0], dy: pending.pan[1] });
+  if (pending.dolly) send({ type: "dolly", amount: pending.dolly });
+  if (pending.zoom) send({ type: "zoom", delta: pending.zoom });
+  pending.orbit = [0, 0];
+  pending.pan = [0, 0];
+  pending.dolly = pending.zoom = 0;
+}
+
+let drag = null;
+
+canvas.addEventListener("pointerdown", (e) => {
+  drag = { x: e.clientX, y: e.clientY, pan: e.button === 2 || e.shiftKey };
+  if (canvas.setPointerCapture && e.pointerId !== undefined) {
+    try { canvas.setPointerCapture(e.pointerId); } catch (_) { /* a synthetic pointer */ }
+  }
+  $("viewport").focus();
+  e.preventDefault();
+});
+canvas.addEventListener("pointermove", (e) => {
+  if (!drag) return;
+  const h = canvas.clientHeight || 1, w = canvas.clientWidth || 1;
+  const dx = e.clientX - drag.x, dy = e.clientY - drag.y;
+  drag.x = e.clientX;
+  drag.y = e.clientY;
+  if (drag.pan || e.shiftKey) queue((p) => { p.pan[0] += dx / h; p.pan[1] += dy / h; });
+  else queue((p) => { p.orbit[0] += Math.PI * dx / w; p.orbit[1] += Math.PI * dy / h; });
+});
+const endDrag = () => { drag = null; };
+canvas.addEventListener("pointerup", endDrag);
+canvas.addEventListener("pointercancel", endDrag);
+canvas.addEventListener("contextmenu", (e) => e.preventDefault());
+canvas.addEventListener("wheel", (e) => {
+  e.preventDefault();
+  const lines = e.deltaMode === 1 ? 40 : e.deltaMode === 2 ? 800 : 1;
+  queue((p) => { p.dolly -= 0.002 * e.deltaY * lines; });
+}, { passive: false });
+
+const WALK = { w: [1, 0, 0], s: [-1, 0, 0], d: [0, 1, 0], a: [0, -1, 0], e: [0, 0, 1], q: [0, 0, -1] };
+document.addEventListener("keydown", (e) => {
+  if (e.target instanceof HTMLSelectElement || e.target instanceof HTMLInputElement) return;
+  const k = e.key.toLowerCase();
+  if ((e.ctrlKey || e.metaKey) && k === "s") { e.preventDefault(); save(); return; }
+  if (e.ctrlKey || e.metaKey || e.altKey) return;
+  if (k in WALK) send({ type: "move", forward: WALK[k][0], right: WALK[k][1], up: WALK[k][2] });
+  else if (k === "arrowleft") queue((p) => { p.orbit[0] -= 0.1; });
+  else if (k === "arrowright") queue((p) => { p.orbit[0] += 0.1; });
+  else if (k === "arrowup") queue((p) => { p.orbit[1] -= 0.1; });
+  else if (k === "arrowdown") queue((p) => { p.orbit[1] += 0.1; });
+  else if (k === "+" || k === "=") queue((p) => { p.zoom -= 0.1; });
+  else if (k === "-" || k === "_") queue((p) => { p.zoom += 0.1; });
+  else if (k === "r") send({ type: "reset" });
+  else return;
+  e.preventDefault();
+});
+
+function save() {
+  $("saved").textContent = "saving…";
+  send({ type: "save", exposure: Number($("exposure").value) });
+}
+
+$("exposure").addEventListener("input", () => {
+  $("exposure-value").textContent = $("exposure").value;
+  draw();
+});
+$("save").addEventListener("click", save);
+for (const id of ["integrator", "shadow_rays", "light_sampler"]) $(id).addEventListener("change", sendOptions);
+
+// ---- self-test (#selftest): what the tests check in a real browser ---------------------------------------
+
+// Resolves with the first frame header for which test(header) holds.
+function waitFrame(test, what, timeoutMs) {
+  return new Promise((resolve, reject) => {
+    const timer = setTimeout(() => { remove(); reject(new Error("timed out waiting for " + what)); }, timeoutMs);
+    const f = (h) => { if (test(h)) { clearTimeout(timer); remove(); resolve(h); } };
+    const remove = () => { const i = listeners.indexOf(f); if (i >= 0) listeners.splice(i, 1); };
+    listeners.push(f);
+  });
+}
+
+function fire(type, x, y, buttons) {
+  canvas.dispatchEvent(new PointerEvent(type, { clientX: x, clientY: y, buttons, button: 0, bubbles: true,
+                                                pointerId: 1, pointerType: "mouse" }));
+}
+
+async function selftest() {
+  const out = $("selftest");
+  out.hidden = false;
+  out.textContent = "selftest running";
+  const log = [];
+  try {
+    // The image converges: two full frames of the first view, the second with more samples.
+    const a = await waitFrame((h) => !h.coarse, "a first full frame", 15000);
+    const b = await waitFrame((h) => !h.coarse && h.view === a.view && h.spp > a.spp, "a converging frame", 15000);
+    log.push(`view ${a.view}: ${a.spp} -> ${b.spp} spp`);
+    // A drag moves the camera: a new view, which starts again from few samples and converges.
+    const r = canvas.getBoundingClientRect();
+    const x = r.left + r.width / 2, y = r.top + r.height / 2;
+    fire("pointerdown", x, y, 1);
+    fire("pointermove", x - 3, y + 1, 1);
+    fire("pointerup", x - 3, y + 1, 0);
+    const c = await waitFrame((h) => h.view > b.view, "a frame of the moved view", 15000);
+    if (!(c.coarse || c.spp < b.spp)) throw new Error(`the moved view did not restart (${c.spp} spp)`);
+    const d = await waitFrame((h) => !h.coarse && h.view === c.view && h.spp > 1, "the moved view converging", 15000);
+    log.push(`drag: view ${c.view} restarted at ${c.spp} spp${c.coarse ? " (coarse)" : ""}, then ${d.spp} spp`);
+    // An option changes the statistics: NEE++'s adaptive policy skips shadow rays.
+    $("shadow_rays").value = "neepp-adaptive";
+    $("shadow_rays").dispatchEvent(new Event("change"));
+    const e = await waitFrame((h) => h.options.shadow_rays === "neepp-adaptive" && !h.coarse && h.shadow_rays_skipped > 0,
+                              "shadow rays skipped with neepp-adaptive", 15000);
+    const shown = Number(document.querySelector('#stats td[data-key="shadow_rays_skipped"]').dataset.value);
+    if (shown !== e.shadow_rays_skipped) throw new Error("the statistics table does not show the frame's numbers");
+    log.push(`neepp-adaptive: ${e.shadow_rays_skipped} shadow rays skipped at ${e.spp} spp`);
+    out.textContent = "selftest ok: " + log.join("; ");
+  } catch (err) {
+    out.textContent = "selftest FAILED: " + err.message + " (" + log.join("; ") + ")";
+  }
+}
+
+connect();
+if (location.hash === "#selftest") selftest();

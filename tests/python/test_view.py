@@ -1,0 +1,480 @@
+"""`neepp view` as a user runs it, on door-ajar at a tiny resolution: the server listens on loopback only and
+serves a page that needs no network; its websocket delivers frames that converge, a camera move restarts
+the image, an option change changes the statistics, save writes the files, malformed messages are refused
+without harm, two pages share the view; the page runs its own self-test in a real headless Chromium; and
+SIGTERM stops it cleanly, freeing the port. Also the viewer's camera and the renderer under it
+(neepp._neepp.LiveRender), which keeps the integrator, and with it NEE++'s map, across camera moves."""
+from __future__ import annotations
+
+import asyncio
+import json
+import math
+import os
+import re
+import shutil
+import signal
+import socket
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+aiohttp = pytest.importorskip("aiohttp", reason="aiohttp is not installed (scripts/setup_python.sh installs it)")
+neepp = pytest.importorskip("neepp", reason="the neepp package is not installed (scripts/test.sh installs it)")
+
+from neepp_tools.view import messages  # noqa: E402
+from neepp_tools.view.orbit import OrbitCamera  # noqa: E402
+
+REPO = Path(__file__).resolve().parents[2]
+DEMO = REPO / "scenes" / "door-ajar" / "scene.xml"
+W, H = 48, 27
+TIMEOUT = 30.0
+
+
+def start_view(neepp_bin, out_dir, *extra):
+    """A `neepp view` of the demo at W x H and the URL it printed."""
+    proc = subprocess.Popen([str(neepp_bin), "view", str(DEMO), "-D", f"resx={W}", "-D", f"resy={H}", "--threads", "1",
+                             "--spp", "100000", "-o", str(out_dir), *extra],
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    line = proc.stdout.readline()
+    m = re.search(r"(http://127\.0\.0\.1:(\d+)/)", line)
+    if not m:
+        proc.kill()
+        pytest.fail(f"neepp view printed no address: {line!r} {proc.stderr.read()[-2000:]}")
+    return proc, m.group(1), int(m.group(2))
+
+
+@pytest.fixture(scope="module")
+def viewer(neepp_bin, tmp_path_factory):
+    out = tmp_path_factory.mktemp("view")
+    proc, url, port = start_view(neepp_bin, out / "saved")
+    yield {"proc": proc, "url": url, "port": port, "out": out / "saved"}
+    proc.send_signal(signal.SIGTERM)
+    proc.wait(timeout=20)
+
+
+class Page:
+    """A websocket client that reads as the page does: the state, errors, saves and decoded frames."""
+
+    def __init__(self, ws):
+        self.ws = ws
+        self.state = None
+
+    async def next(self, timeout=TIMEOUT):
+        msg = await self.ws.receive(timeout=timeout)
+        if msg.type == aiohttp.WSMsgType.BINARY:
+            header, pixels = messages.decode_frame(msg.data)
+            image = np.frombuffer(pixels, dtype="<f4").reshape(header["height"], header["width"], 3)
+            return {"type": "frame", **header, "image": image}
+        if msg.type == aiohttp.WSMsgType.TEXT:
+            m = json.loads(msg.data)
+            if m["type"] == "state":
+                self.state = m
+            return m
+        return {"type": "closed", "ws_type": str(msg.type)}
+
+    async def until(self, test, what, timeout=TIMEOUT):
+        """The first message for which test holds (messages before it are passed over)."""
+        deadline = time.monotonic() + timeout
+        while True:
+            left = deadline - time.monotonic()
+            if left <= 0:
+                raise AssertionError(f"timed out waiting for {what}")
+            m = await self.next(left)
+            if test(m):
+                return m
+            assert m["type"] != "closed", f"the server closed the websocket while waiting for {what}: {m}"
+
+    async def send(self, msg):
+        await self.ws.send_str(msg if isinstance(msg, str) else json.dumps(msg))
+
+
+def full_frame(view=None):
+    return lambda m: m["type"] == "frame" and not m["coarse"] and (view is None or m["view"] == view)
+
+
+async def with_page(url, body):
+    async with aiohttp.ClientSession() as http:
+        async with http.ws_connect(url + "ws") as ws:
+            return await body(Page(ws))
+
+
+def run(coro):
+    return asyncio.run(coro)
+
+
+# The camera and the renderer under the server (before the server starts: it would share the cores).
+
+def test_live_render_keeps_its_integrator_across_camera_moves():
+    scene = neepp.load(DEMO, resx=32, resy=18)
+    live = neepp._neepp.LiveRender(scene, "path", {"shadow_rays": "neepp"}, 2, "", 0)
+    merged = lambda stats: stats["integrator_statistics"]["shadow_rays"]["roulette"]["passes_merged"]  # noqa: E731
+    first = json.loads(live.render(8))
+    assert live.prepared and merged(first) == first["passes"]
+    cam = OrbitCamera(scene.camera["to_world"], scene.camera["fov"], scene.bounds)
+    cam.orbit(0.3, 0.0)
+    live.set_camera(cam.to_world(), cam.fov)
+    frames = []
+    second = json.loads(live.render(8, on_frame=lambda image, info: frames.append((image.shape, info))))
+    assert merged(second) == first["passes"] + second["passes"]  # the map went on learning
+    assert frames[-1][1]["final"] and frames[-1][1]["spp"] == 8 and frames[-1][0] == (18, 32, 3)
+    coarse = []
+    live.render(1, scale=4, on_frame=lambda image, info: coarse.append(image.shape))
+    assert coarse == [(5, 8, 3)] and scene.width == 32  # the film is back to its size
+    live.set_integrator("path", {"shadow_rays": "neepp"})  # new options: a new integrator, prepared anew
+    assert not live.prepared
+    with pytest.raises(ValueError, match="rotation"):
+        live.set_camera([[2, 0, 0, 0], [0, 1, 0, 0], [0, 0, 1, 0], [0, 0, 0, 1]], 40)
+    with pytest.raises(ValueError, match="fov"):
+        live.set_camera(cam.to_world(), 200)
+    assert scene.camera["fov"] == pytest.approx(cam.fov)  # a refused camera leaves the one in force
+
+
+def test_live_render_cancel_stops_at_once():
+    scene = neepp.load(DEMO, resx=64, resy=36)
+    live = neepp._neepp.LiveRender(scene, "path", {}, 2, "", 0)
+    seen = []
+
+    def on_frame(image, info):
+        seen.append(info["spp"])
+        live.cancel()  # as the server does, from another thread, when the camera moves
+
+    stats = json.loads(live.render(1_000_000, display_interval=0.0, on_frame=on_frame))
+    assert stats["stopped_by"] == "cancel" and stats["spp"] < 1000
+    live.clear_cancel()
+    assert json.loads(live.render(2))["stopped_by"] == "spp"
+
+
+def test_orbit_camera_moves():
+    to_world = [[1, 0, 0, 0], [0, 1, 0, 1], [0, 0, 1, -5], [0, 0, 0, 1]]
+    cam = OrbitCamera(to_world, 40.0, ((-1, -1, -1), (1, 1, 1)))
+    assert np.allclose(cam.to_world(), to_world)  # the scene's own camera, as it was
+    d = cam.distance
+    cam.orbit(0.5, 0.3)
+    assert cam.distance == pytest.approx(d) and not np.allclose(cam.to_world(), to_world)
+    m = np.array(cam.to_world())
+    assert np.allclose(m[:3, :3].T @ m[:3, :3], np.identity(3), atol=1e-9)  # still a rotation
+    assert np.allclose(m[:3, 2], (cam.target - cam.position) / cam.distance)  # looking at the target
+    cam.orbit(0.0, 100.0)  # never over the pole
+    assert np.dot(np.array(cam.to_world())[:3, 1], [0, 1, 0]) > 0
+    target = cam.target.copy()
+    cam.pan(0.1, 0.0)
+    assert not np.allclose(cam.target, target) and cam.distance == pytest.approx(d)
+    cam.dolly(math.log(2))
+    assert cam.distance == pytest.approx(d / 2)
+    cam.zoom(10.0)
+    assert cam.fov == 150.0
+    cam.reset()
+    assert np.allclose(cam.to_world(), to_world) and cam.fov == 40.0
+    mirrored = [[-1, 0, 0, 0], [0, 1, 0, 1], [0, 0, 1, -5], [0, 0, 0, 1]]
+    assert np.allclose(OrbitCamera(mirrored, 40.0, ((-1, -1, -1), (1, 1, 1))).to_world(), mirrored)
+
+
+# The server, as a user runs it.
+
+def test_listens_on_loopback_only(viewer):
+    out = subprocess.run(["ss", "-ltnpH"], capture_output=True, text=True).stdout
+    mine = [line.split() for line in out.splitlines() if f"pid={viewer['proc'].pid}," in line]
+    assert mine, out
+    for fields in mine:
+        assert fields[3].startswith("127.0.0.1:"), fields
+    assert any(fields[3] == f"127.0.0.1:{viewer['port']}" for fields in mine)
+
+
+def test_page_needs_no_network_and_answers_its_own_host_only(viewer):
+    async def body():
+        async with aiohttp.ClientSession() as http:
+            texts = {}
+            for name in ("", "view.js", "view.css"):
+                async with http.get(viewer["url"] + name) as r:
+                    assert r.status == 200, name
+                    assert "default-src 'self'" in r.headers["Content-Security-Policy"]
+                    texts[name] = await r.text()
+            # A page elsewhere reaching the port by another name (DNS rebinding) is refused.
+            async with http.get(viewer["url"], headers={"Host": f"attacker.example:{viewer['port']}"}) as r:
+                assert r.status == 403
+            async with http.get(viewer["url"] + "../../etc/passwd") as r:
+                assert r.status == 404
+            return texts
+
+    texts = run(body())
+    for name, text in texts.items():
+        assert not re.search(r"(https?:)?//[a-z0-9.-]+\.[a-z]{2,}", text, flags=re.I), name
+    assert 'src="view.js"' in texts[""] and "ws://" in texts["view.js"]
+
+
+def test_frames_converge_on_two_pages_at_once(viewer):
+    async def body():
+        async with aiohttp.ClientSession() as http:
+            async with http.ws_connect(viewer["url"] + "ws") as a, http.ws_connect(viewer["url"] + "ws") as b:
+                pa, pb = Page(a), Page(b)
+                state = await pa.until(lambda m: m["type"] == "state", "the state")
+                assert state["width"] == W and state["height"] == H and state["integrator"] == "path"
+                names = [d["name"] for d in state["catalog"]["integrators"]]
+                assert "path" in names and "bdpt" in names
+                policies = [p[0] for p in state["catalog"]["shadow_ray_policies"]]
+                assert {"nee", "neepp", "neepp-adaptive"} <= set(policies)
+                first = await pa.until(full_frame(), "a full frame")
+                later = [await pa.until(full_frame(first["view"]), "more frames") for _ in range(3)]
+                other = await pb.until(full_frame(first["view"]), "a frame on the second page")
+                return first, later, other
+
+    first, later, other = run(body())
+    spps = [first["spp"]] + [f["spp"] for f in later]
+    assert spps == sorted(spps) and spps[-1] > spps[0], spps
+    last = later[-1]
+    assert last["image"].shape == (H, W, 3) and np.all(np.isfinite(last["image"])) and last["image"].mean() > 0
+    assert last["rays"] > first["rays"] and last["samples_per_s"] > 0
+    assert other["view"] == first["view"]
+
+
+def test_a_camera_move_restarts_the_image(viewer):
+    async def body(page):
+        before = await page.until(full_frame(), "a full frame")
+        before = await page.until(lambda m: full_frame(before["view"])(m) and m["spp"] >= 8, "convergence")
+        await page.send({"type": "orbit", "dx": -0.2, "dy": 0.05})  # still inside the room
+        restart = await page.until(lambda m: m["type"] == "frame" and m["view"] > before["view"], "the moved view")
+        full = await page.until(full_frame(restart["view"]), "its first full frame")
+        more = await page.until(lambda m: full_frame(restart["view"])(m) and m["spp"] > full["spp"], "it converging")
+        return before, restart, full, more
+
+    before, restart, full, more = run(with_page(viewer["url"], body))
+    # The new view starts again from few samples (a coarse image first, a quarter of the resolution at one
+    # sample per pixel, unless a newer frame replaced it before it was sent), then converges.
+    if restart["coarse"]:
+        assert restart["spp"] == 1 and restart["width"] == math.ceil(W / 4), restart
+    assert full["spp"] < before["spp"] and more["spp"] > full["spp"]
+    assert restart["to_world"] != before["to_world"] and restart["fov"] == before["fov"]
+    assert not np.allclose(full["image"].mean(), 0)
+
+
+def test_an_option_change_changes_the_statistics(viewer):
+    async def body(page):
+        nee = await page.until(lambda m: full_frame()(m) and m["spp"] >= 2, "a frame")
+        await page.send({"type": "options", "integrator": "path", "options": {"shadow_rays": "neepp-adaptive"}})
+        state = await page.until(lambda m: m["type"] == "state" and m["options"].get("shadow_rays") == "neepp-adaptive",
+                                 "the new state")
+        adaptive = await page.until(lambda m: full_frame()(m) and m["options"].get("shadow_rays") == "neepp-adaptive"
+                                    and m["shadow_rays_skipped"] > 0, "shadow rays skipped")
+        # A refused option: said why, and the options in force stay.
+        await page.send({"type": "options", "integrator": "path", "options": {"no_such_option": "1"}})
+        error = await page.until(lambda m: m["type"] == "error", "the error")
+        kept = await page.until(lambda m: m["type"] == "state", "the state in force")
+        await page.send({"type": "options", "integrator": "path", "options": {}})  # back to the scene's
+        await page.until(lambda m: m["type"] == "state" and "shadow_rays" not in m["options"], "the scene's options")
+        return nee, state, adaptive, error, kept
+
+    nee, state, adaptive, error, kept = run(with_page(viewer["url"], body))
+    assert nee["shadow_rays_skipped"] == 0 and nee["shadow_rays"] > 0
+    assert adaptive["shadow_rays_skipped"] > 0
+    assert "no_such_option" in error["message"]
+    assert kept["options"] == {"shadow_rays": "neepp-adaptive"}
+
+
+def test_save_writes_exr_png_and_statistics(viewer):
+    async def body(page):
+        await page.until(full_frame(), "a full frame")
+        await page.send({"type": "save", "exposure": 1.0})
+        return await page.until(lambda m: m["type"] in ("saved", "error"), "the save")
+
+    saved = run(with_page(viewer["url"], body))
+    assert saved["type"] == "saved", saved
+    exr, png, stats = (Path(f) for f in saved["files"])
+    assert exr.suffix == ".exr" and png.suffix == ".png" and stats.suffix == ".json"
+    assert exr.parent == viewer["out"]
+    image = neepp.read_exr(exr)
+    assert image.shape[:2] == (H, W) and image[..., :3].mean() > 0
+    assert neepp.read_image(png).shape[:2] == (H, W)
+    record = json.loads(stats.read_text())
+    assert record["spp"] >= 1 and record["exposure"] == 1.0 and len(record["to_world"]) == 4
+    assert record["scene"].endswith("scene.xml") and "shadow_rays" in record and "integrator" in record
+
+
+@pytest.mark.parametrize("bad, expect", [
+    ("not json", "not JSON"),
+    ("[1, 2]", "JSON object"),
+    ('{"type": "orbit", "dx": "left", "dy": 0}', "finite number"),
+    ('{"type": "orbit", "dx": NaN, "dy": 0}', "finite number"),
+    ('{"type": "orbit", "dx": 1e300, "dy": 0}', "out of range"),
+    ('{"type": "pan", "dx": 0.1}', "'dy'"),
+    ('{"type": "zoom", "delta": true}', "finite number"),
+    ('{"type": "teleport"}', "unknown message type"),
+    ('{"type": "options", "integrator": "path", "options": {"shadow_rays": 3}}', "string"),
+    ('{"type": "options", "integrator": "", "options": {}}', "'integrator'"),
+    ('{"type": "options", "integrator": "no-such", "options": {}}', "no-such"),
+    ("[" * 5000 + "]" * 5000, "not JSON"),  # deeper than the parser goes
+    (b"\x00\x01binary", "JSON text"),
+])
+def test_malformed_messages_are_refused(viewer, bad, expect):
+    async def body(page):
+        await page.until(lambda m: m["type"] == "state", "the state")
+        if isinstance(bad, bytes):
+            await page.ws.send_bytes(bad)
+        else:
+            await page.send(bad)
+        error = await page.until(lambda m: m["type"] == "error", "the error")
+        # The page is still served: a camera move still makes a new view.
+        frame = await page.until(full_frame(), "a frame")
+        await page.send({"type": "dolly", "amount": 0.01})
+        await page.until(lambda m: m["type"] == "frame" and m["view"] > frame["view"], "a new view")
+        return error
+
+    error = run(with_page(viewer["url"], body))
+    assert expect in error["message"], error
+    assert viewer["proc"].poll() is None
+
+
+def test_an_oversized_message_closes_only_its_websocket(viewer):
+    async def body():
+        async with aiohttp.ClientSession() as http:
+            async with http.ws_connect(viewer["url"] + "ws") as ws:
+                await ws.send_str(json.dumps({"type": "dolly", "amount": 0.0, "pad": "x" * 100_000}))
+                while True:
+                    msg = await ws.receive(timeout=TIMEOUT)
+                    if msg.type in (aiohttp.WSMsgType.CLOSE, aiohttp.WSMsgType.CLOSED, aiohttp.WSMsgType.CLOSING):
+                        break
+        return await with_page(viewer["url"], lambda page: page.until(full_frame(), "a frame after it"))
+
+    assert run(body())["spp"] >= 1
+    assert viewer["proc"].poll() is None
+
+
+def _chromium():
+    exe = shutil.which("chromium") or shutil.which("chromium-browser")
+    if exe is None:
+        pytest.skip("chromium is not installed (scripts/test.sh installs it)")
+    return [exe, "--headless", "--no-sandbox", "--disable-gpu", "--hide-scrollbars", "--no-first-run"]
+
+
+async def run_in_chromium(url, profile: Path, timeout=90.0):
+    """Opens url in a headless Chromium driven over its DevTools protocol (the page's self-test waits on
+    the websocket in real time, which --dump-dom's virtual time would not give it) and waits for the
+    self-test's verdict. Returns (verdict, console problems, every URL the page requested)."""
+    log = open(profile.parent / "chromium.log", "w")
+    proc = subprocess.Popen(_chromium() + [f"--user-data-dir={profile}", "--remote-debugging-port=0", "about:blank"],
+                            stdout=log, stderr=log)
+    problems, urls, verdict = [], [], None
+    try:
+        deadline = time.monotonic() + timeout
+        port_file = profile / "DevToolsActivePort"
+        while not (port_file.exists() and port_file.read_text().strip()):
+            assert proc.poll() is None and time.monotonic() < deadline, "chromium did not start"
+            await asyncio.sleep(0.1)
+        port = int(port_file.read_text().split()[0])
+        async with aiohttp.ClientSession() as http:
+            async with http.get(f"http://127.0.0.1:{port}/json/list") as r:
+                target = next(t for t in await r.json() if t["type"] == "page")
+            async with http.ws_connect(target["webSocketDebuggerUrl"], max_msg_size=0) as ws:
+                ids = iter(range(1, 1 << 30))
+
+                async def call(method, **params):
+                    i = next(ids)
+                    await ws.send_json({"id": i, "method": method, "params": params})
+                    return i
+
+                for method in ("Runtime.enable", "Log.enable", "Network.enable"):
+                    await call(method)
+                await call("Page.navigate", url=url)
+                asking = None
+                while verdict is None and time.monotonic() < deadline:
+                    if asking is None:
+                        asking = await call("Runtime.evaluate", returnByValue=True,
+                                            expression="(document.getElementById('selftest') || {}).textContent || ''")
+                    try:
+                        msg = await ws.receive_json(timeout=0.5)
+                    except asyncio.TimeoutError:
+                        continue
+                    method, params = msg.get("method"), msg.get("params", {})
+                    if method == "Runtime.exceptionThrown":
+                        problems.append(params["exceptionDetails"].get("text", "exception"))
+                    elif method == "Runtime.consoleAPICalled" and params["type"] in ("error", "warning", "assert"):
+                        problems.append(" ".join(str(a.get("value", a.get("description"))) for a in params["args"]))
+                    elif method == "Log.entryAdded" and params["entry"]["level"] in ("error", "warning"):
+                        problems.append(params["entry"]["text"])
+                    elif method == "Network.requestWillBeSent":
+                        urls.append(params["request"]["url"])
+                    elif method == "Network.webSocketCreated":
+                        urls.append(params["url"])
+                    elif msg.get("id") == asking:
+                        text = msg.get("result", {}).get("result", {}).get("value", "")
+                        if text.startswith("selftest ok") or text.startswith("selftest FAILED"):
+                            verdict = text
+                        asking = None
+                        await asyncio.sleep(0.2)
+    finally:
+        proc.terminate()
+        try:
+            proc.wait(timeout=10)
+        except subprocess.TimeoutExpired:
+            proc.kill()
+        log.close()
+    return verdict, problems, urls
+
+
+def test_page_in_headless_chromium(viewer, tmp_path):
+    """The page's own self-test (#selftest) in a real browser: frames converge, a mouse drag restarts the
+    view, switching the shadow-ray policy to neepp-adaptive shows shadow rays skipped; no console error,
+    and nothing requested from anywhere but the server."""
+    verdict, problems, urls = run(run_in_chromium(viewer["url"] + "#selftest", tmp_path / "profile"))
+    assert verdict and verdict.startswith("selftest ok"), (verdict, problems)
+    assert not problems, problems
+    ws_url = viewer["url"].replace("http://", "ws://")
+    assert urls and all(u.startswith(viewer["url"]) or u.startswith(ws_url) for u in urls), urls
+    assert any(u.endswith("/ws") for u in urls) and any(u.endswith("view.js") for u in urls), urls
+
+
+def test_sigterm_stops_it_cleanly_and_frees_the_port(neepp_bin, tmp_path):
+    proc, url, port = start_view(neepp_bin, tmp_path / "saved")
+    try:
+        async def body(page):  # a page open and frames flowing when the signal comes
+            await page.until(full_frame(), "a frame")
+            proc.send_signal(signal.SIGTERM)
+            return await page.until(lambda m: m["type"] == "closed", "the server closing the page", timeout=20)
+
+        run(with_page(url, body))
+        assert proc.wait(timeout=20) == 0, proc.stderr.read()[-2000:]
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+    assert "Traceback" not in proc.stderr.read()
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", port))  # free again
+
+
+def test_a_port_in_use_is_a_clear_error(neepp_bin, tmp_path):
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        s.listen(1)
+        port = s.getsockname()[1]
+        r = subprocess.run([str(neepp_bin), "view", str(DEMO), "-D", f"resx={W}", "-D", f"resy={H}", "--port", str(port)],
+                           capture_output=True, text=True, timeout=60)
+    assert r.returncode == 1 and f"127.0.0.1:{port}" in r.stderr and "Traceback" not in r.stderr, r.stderr
+
+
+def test_without_its_python_modules_it_says_what_is_missing(neepp_bin, tmp_path):
+    bare = tmp_path / "bare_python"
+    bare.write_text(f'#!/bin/sh\nexec "{sys.executable}" -S "$@"\n')  # -S: no site-packages
+    bare.chmod(0o755)
+    r = subprocess.run([str(neepp_bin), "view", str(DEMO)], capture_output=True, text=True, timeout=60,
+                       env=dict(os.environ, NEEPP_PYTHON=str(bare)))
+    assert r.returncode == 1 and "Traceback" not in r.stderr, r.stderr[-2000:]
+    assert "aiohttp" in r.stderr and "scripts/setup_python.sh" in r.stderr, r.stderr[-2000:]
+
+
+def test_without_the_neepp_package_it_says_how_to_install_it(neepp_bin, tmp_path):
+    """A Python with aiohttp but not the package built from the checkout (setup_python.sh without test.sh)."""
+    no_package = tmp_path / "python_without_neepp"
+    no_package.write_text(f"#!{sys.executable}\n"
+                          "import runpy, sys\n"
+                          "sys.modules['neepp'] = None  # as if not installed\n"
+                          "assert sys.argv[1] == '-m'\n"
+                          "module, sys.argv = sys.argv[2], sys.argv[2:]\n"
+                          "runpy.run_module(module, run_name='__main__', alter_sys=True)\n")
+    no_package.chmod(0o755)
+    r = subprocess.run([str(neepp_bin), "view", str(DEMO)], capture_output=True, text=True, timeout=60,
+                       env=dict(os.environ, NEEPP_PYTHON=str(no_package)))
+    assert r.returncode == 1 and "Traceback" not in r.stderr, r.stderr[-2000:]
+    assert "neepp Python package" in r.stderr and "pip install" in r.stderr, r.stderr[-2000:]
