@@ -10,4 +10,5 @@ NB_MODULE(_neepp, m) {
     neepp::python::bind_scene(m);
     neepp::python::bind_render(m);
     neepp::python::bind_visibility(m);
+    neepp::python::bind_checkpoint(m);
 }

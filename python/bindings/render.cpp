@@ -19,14 +19,14 @@
 
 namespace neepp::python {
 
-namespace {
-
 std::unique_ptr<Integrator> scene_integrator(const Scene &scene, const std::string &name,
                                              const std::map<std::string, std::string> &overrides) {
     Options options(scene.settings.integrator_options);
     for (const auto &[key, value] : overrides) options.set(key, value);
     return make_integrator(name.empty() ? scene.settings.integrator : name, options);
 }
+
+namespace {
 
 RenderJob make_job(const Scene &scene, int spp, double time_s, uint64_t seed, int threads, const std::string &sampler) {
     RenderJob job;
@@ -113,16 +113,6 @@ std::pair<nb::ndarray<nb::numpy, float>, std::string> render_scene(const Scene &
     nlohmann::json stats = render_statistics(scene, *integrator, w.result, job);
     if (w.interrupted) stats["interrupted"] = true;
     return {to_numpy(std::move(w.result.image)), stats.dump()};
-}
-
-template <typename T> nb::ndarray<nb::numpy, T> vector_to_numpy(std::vector<T> &&v) {
-    auto *owned = new std::vector<T>(std::move(v));
-    nb::capsule owner(owned, [](void *p) noexcept { delete static_cast<std::vector<T> *>(p); });
-    return nb::ndarray<nb::numpy, T>(owned->data(), {owned->size()}, owner);
-}
-
-template <typename T> std::vector<T> numpy_to_vector(const nb::ndarray<const T, nb::ndim<1>, nb::c_contig, nb::device::cpu> &a) {
-    return std::vector<T>(a.data(), a.data() + a.shape(0));
 }
 
 // One range of sample indices, [first, last), continued from what earlier ranges learned (state, empty:
