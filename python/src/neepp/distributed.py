@@ -135,6 +135,9 @@ class _Ray:
             os.environ.setdefault("RAY_ENABLE_WINDOWS_OR_OSX_CLUSTER", "0")
         import ray
         self.ray = ray
+        # ray.init puts a handler of its own on SIGTERM, which ends the process at once: a caller's own
+        # (the CLI's, which saves a checkpoint first) is put back.
+        on_sigterm = signal.getsignal(signal.SIGTERM)
         if not ray.is_initialized():
             if address:
                 ray.init(address=address, log_to_driver=False)
@@ -142,6 +145,8 @@ class _Ray:
                 from ray._private import ray_constants  # read at start-up: when ray was imported before us
                 ray_constants.ENABLE_RAY_CLUSTER = False
                 ray.init(num_cpus=max(workers * threads, 1), include_dashboard=False, log_to_driver=False)
+        if callable(on_sigterm) and threading.current_thread() is threading.main_thread():
+            signal.signal(signal.SIGTERM, on_sigterm)
         self.task = ray.remote(num_cpus=threads, max_retries=3)(_render_range)
 
     def submit(self, *args):
