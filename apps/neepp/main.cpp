@@ -20,6 +20,7 @@
 #include "neepp/light_selection/factory.h"
 #include "neepp/loader/scene_loader.h"
 #include "neepp/loader/supported_plugins.h"
+#include "neepp/render/checkpoint_identity.h"
 #include "neepp/render/huge_pages.h"
 #include "neepp/render/render_output.h"
 #include "neepp/visibility/map_file.h"
@@ -83,38 +84,6 @@ void check_output_path(const std::string &path, const char *what, const char *ex
     if (access(dir.c_str(), W_OK) != 0)
         throw std::runtime_error(fmt::format("cannot write the {} '{}': the folder '{}' is not writable", what, path,
                                              dir.string()));
-}
-
-// What a checkpoint must match to be resumed: the same scene (file and geometry), integrator and
-// options, seed, sampler, film and filter.
-nlohmann::json render_identity(const neepp::Scene &scene, const neepp::Integrator &integrator, const neepp::RenderJob &job,
-                               const std::map<std::string, std::string> &defines) {
-    return {{"scene", std::filesystem::absolute(scene.source_path).lexically_normal().string()},
-            {"scene_fingerprint", fmt::format("{:016x}", neepp::scene_fingerprint(scene))},
-            {"parameters", defines},
-            {"integrator", integrator.describe()},
-            {"seed", job.seed},
-            {"sampler", job.sampler},
-            {"film", fmt::format("{}x{}", scene.camera.width, scene.camera.height)},
-            {"crop", fmt::format("{},{} of {}x{}", scene.camera.crop_x, scene.camera.crop_y, scene.camera.film_width,
-                                 scene.camera.film_height)},
-            {"rfilter", fmt::format("{} {} {}", scene.settings.rfilter, scene.settings.rfilter_radius,
-                                    scene.settings.rfilter_stddev)}};
-}
-
-// Reads the checkpoint a --resume continues and checks that it is this render's.
-neepp::RenderCheckpoint checkpoint_to_resume(const std::string &path, const nlohmann::json &identity) {
-    if (!std::filesystem::exists(path))
-        throw std::runtime_error(fmt::format("--resume: no checkpoint '{}' (a render with --checkpoint writes it)", path));
-    neepp::RenderCheckpoint c = neepp::load_checkpoint(path);
-    const nlohmann::json theirs = nlohmann::json::parse(c.identity);
-    for (const auto &[key, mine] : identity.items())
-        if (!theirs.contains(key) || theirs[key] != mine) {
-            const std::string was = theirs.contains(key) ? theirs[key].dump() : "missing";
-            throw std::runtime_error(fmt::format("--resume: the checkpoint '{}' is of another render: its {} is {}, this "
-                                                 "render's is {}", path, key, was, mine.dump()));
-        }
-    return c;
 }
 
 struct Rendered {
@@ -184,10 +153,10 @@ Rendered run_render(const RenderArgs &a) {
     // --checkpoint writes the render's state beside the image (OUTPUT.checkpoint) and the image so far;
     // --resume continues from that state. A render that reaches its sample count removes it.
     const std::string checkpoint_path = a.output + ".checkpoint";
-    const nlohmann::json identity = render_identity(*scene, *integrator, job, defines);
+    const nlohmann::json identity = neepp::render_identity(*scene, *integrator, job.seed, job.sampler, defines);
     neepp::RenderCheckpoint resumed;
     if (a.resume) {
-        resumed = checkpoint_to_resume(checkpoint_path, identity);
+        resumed = neepp::checkpoint_to_resume(checkpoint_path, identity);
         job.resume = &resumed;
     }
     if (a.checkpoint_s > 0) {
@@ -233,7 +202,7 @@ Rendered run_render(const RenderArgs &a) {
     if (!a.snapshots.empty() && result.spp > 0 &&
         (snapshot_index.empty() || snapshot_index.back()["spp"].get<int>() != result.spp))
         write_snapshot(result.spp, result.render_time_s, result.image);
-    if ((a.resume || a.checkpoint_s > 0) && result.stopped_by == "spp") std::filesystem::remove(checkpoint_path);
+    if ((a.resume || a.checkpoint_s > 0) && result.stopped_by == "spp") neepp::remove_checkpoint(checkpoint_path);
     nlohmann::json stats = neepp::render_statistics(*scene, *integrator, result, job);
     stats["load_time_s"] = load_s;
     if (!a.stats.empty()) neepp::write_file_atomically(a.stats, stats.dump(2) + "\n");

@@ -3,14 +3,12 @@
 #include <map>
 #include <memory>
 #include <string>
+#include <vector>
 #include <nanobind/nanobind.h>
 #include <nanobind/ndarray.h>
+#include "neepp/base/integrator.h"
 #include "neepp/io/image.h"
-
-namespace neepp {
-class Integrator;
-class Scene;
-}  // namespace neepp
+#include "neepp/scene/scene.h"
 
 namespace neepp::python {
 
@@ -22,9 +20,10 @@ void bind_scene(nb::module_ &m);
 void bind_render(nb::module_ &m);
 void bind_visibility(nb::module_ &m);
 void bind_live_render(nb::module_ &m);
+void bind_checkpoint(nb::module_ &m);
 
-// The integrator a render of the scene uses: the named one (empty: the file's), with the file's options
-// and then the overrides (the CLI's -I).
+// The integrator `name` (empty: the scene's) with the scene's options, overridden by `overrides`: as
+// the CLI makes it.
 std::unique_ptr<Integrator> scene_integrator(const Scene &scene, const std::string &name,
                                              const std::map<std::string, std::string> &overrides);
 
@@ -32,5 +31,16 @@ std::unique_ptr<Integrator> scene_integrator(const Scene &scene, const std::stri
 nb::ndarray<nb::numpy, float> to_numpy(Image &&image);
 // An image from an (H, W), (H, W, 1), (H, W, 3) or (H, W, 4) float32 array (copied).
 Image from_numpy(const nb::ndarray<const float, nb::c_contig, nb::device::cpu> &array);
+
+// A 1-D numpy array that takes over the vector (no copy), and a vector copied from one (a render's sums).
+template <typename T> nb::ndarray<nb::numpy, T> vector_to_numpy(std::vector<T> &&v) {
+    auto *owned = new std::vector<T>(std::move(v));
+    nb::capsule owner(owned, [](void *p) noexcept { delete static_cast<std::vector<T> *>(p); });
+    return nb::ndarray<nb::numpy, T>(owned->data(), {owned->size()}, owner);
+}
+template <typename T> using Array1D = nb::ndarray<const T, nb::ndim<1>, nb::c_contig, nb::device::cpu>;
+template <typename T> std::vector<T> numpy_to_vector(const Array1D<T> &a) {
+    return std::vector<T>(a.data(), a.data() + a.shape(0));
+}
 
 }  // namespace neepp::python

@@ -11,4 +11,5 @@ NB_MODULE(_neepp, m) {
     neepp::python::bind_render(m);
     neepp::python::bind_visibility(m);
     neepp::python::bind_live_render(m);
+    neepp::python::bind_checkpoint(m);
 }

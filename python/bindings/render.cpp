@@ -115,16 +115,6 @@ std::pair<nb::ndarray<nb::numpy, float>, std::string> render_scene(const Scene &
     return {to_numpy(std::move(w.result.image)), stats.dump()};
 }
 
-template <typename T> nb::ndarray<nb::numpy, T> vector_to_numpy(std::vector<T> &&v) {
-    auto *owned = new std::vector<T>(std::move(v));
-    nb::capsule owner(owned, [](void *p) noexcept { delete static_cast<std::vector<T> *>(p); });
-    return nb::ndarray<nb::numpy, T>(owned->data(), {owned->size()}, owner);
-}
-
-template <typename T> std::vector<T> numpy_to_vector(const nb::ndarray<const T, nb::ndim<1>, nb::c_contig, nb::device::cpu> &a) {
-    return std::vector<T>(a.data(), a.data() + a.shape(0));
-}
-
 // One range of sample indices, [first, last), continued from what earlier ranges learned (state, empty:
 // nothing): its sums, what it learned, and its statistics. The unit of distributed rendering.
 nb::dict render_range(const Scene &scene, const std::string &integrator_name,

@@ -131,6 +131,6 @@ def test_the_cli_renders_on_ray(tmp_path):
     import json
     stats = json.loads((tmp_path / "ray" / "a.json").read_text())
     assert stats["spp"] == 8 and stats["distributed"]["workers"] == 2
-    r = subprocess.run([cli, "render", *common, "-o", str(tmp_path / "c.exr"), "--ray", "--checkpoint", "5"],
-                       capture_output=True, text=True, timeout=300)
-    assert r.returncode != 0 and "--checkpoint is not available with --ray" in r.stderr
+    r = subprocess.run([cli, "render", *common, "-o", str(tmp_path / "c.exr"), "--ray", "--display-server",
+                        "127.0.0.1:14158"], capture_output=True, text=True, timeout=300)
+    assert r.returncode != 0 and "--display-server is not available with --ray" in r.stderr

@@ -17,6 +17,11 @@ summed) between rounds and sent back with the next ranges, and rounds grow geome
 learns early, as the render loop's passes do. An integrator that learns nothing renders everything left in
 the second round.
 
+The driver can die too: with checkpoint= and checkpoint_every=, it saves what the rounds so far summed and
+learned at the end of a round (distributed_checkpoint.py), and resume=True goes on from there to the same
+bits. Checkpoints sit at round boundaries because a round's ranges all start from the state merged before
+it: a range half done holds nothing another driver could use.
+
 A worker that dies has its range rendered again by Ray (tasks are retried; only a finished range's sums
 are ever added, so nothing is lost or counted twice). A scene that a worker cannot load (a cluster whose
 workers lack its files) raises the worker's SceneError in the driver.
@@ -39,13 +44,9 @@ from typing import Callable, Dict, List, Optional, Union
 import numpy as np
 
 from . import _neepp, load, option_text
+from . import distributed_checkpoint as dc
 
 __all__ = ["render", "schedule_rounds"]
-
-# Statistics that add up over ranges.
-_SUMMED = ["rays", "camera_rays", "light_rays", "splats", "shadow_rays", "shadow_rays_occluded",
-           "shadow_rays_skipped", "occlusion_time_s", "invalid_samples", "density_lookups",
-           "transmittance_lookups", "medium_shadow_rays"]
 
 _scenes: Dict[str, object] = {}  # a worker process's loaded scenes (Ray reuses processes across tasks)
 
@@ -107,6 +108,13 @@ def schedule_rounds(spp: int, workers: int, learns: bool, first_round: int = 1) 
     return rounds
 
 
+def _round_ends_at(plan: List[List[tuple]], rounds: int, start: int) -> bool:
+    """Whether the first `rounds` rounds (sample 0, then plan's) end at sample index start."""
+    if rounds == 1:
+        return start == 1
+    return 2 <= rounds <= len(plan) + 1 and plan[rounds - 2][-1][1] == start
+
+
 class _Local:
     """Runs the tasks in this process, one after another (the reference a cluster's image must equal)."""
 
@@ -127,6 +135,9 @@ class _Ray:
             os.environ.setdefault("RAY_ENABLE_WINDOWS_OR_OSX_CLUSTER", "0")
         import ray
         self.ray = ray
+        # ray.init puts a handler of its own on SIGTERM, which ends the process at once: a caller's own
+        # (the CLI's, which saves a checkpoint first) is put back.
+        on_sigterm = signal.getsignal(signal.SIGTERM)
         if not ray.is_initialized():
             if address:
                 ray.init(address=address, log_to_driver=False)
@@ -134,6 +145,8 @@ class _Ray:
                 from ray._private import ray_constants  # read at start-up: when ray was imported before us
                 ray_constants.ENABLE_RAY_CLUSTER = False
                 ray.init(num_cpus=max(workers * threads, 1), include_dashboard=False, log_to_driver=False)
+        if callable(on_sigterm) and threading.current_thread() is threading.main_thread():
+            signal.signal(signal.SIGTERM, on_sigterm)
         self.task = ray.remote(num_cpus=threads, max_retries=3)(_render_range)
 
     def submit(self, *args):
@@ -188,7 +201,9 @@ class _Bar:
 def render(scene_path, spp: Optional[int] = None, time: Optional[float] = None, workers: int = 2,
            address: Optional[str] = None, integrator: Optional[str] = None, options: Optional[dict] = None,
            seed: Optional[int] = None, threads: int = 1, sampler: Optional[str] = None,
-           progress: Union[None, bool, Callable[[float], None]] = None, local: bool = False, **params):
+           progress: Union[None, bool, Callable[[float], None]] = None, local: bool = False,
+           checkpoint: Optional[str] = None, checkpoint_every: Optional[float] = None, resume: bool = False,
+           on_checkpoint: Optional[Callable[[np.ndarray], None]] = None, **params):
     """Renders a scene on `workers` Ray workers (each with `threads` threads); returns ``(image, stats)`` as
     neepp.render does. Scene parameters are keyword arguments (as neepp.load's), integrator options a dict.
 
@@ -196,6 +211,15 @@ def render(scene_path, spp: Optional[int] = None, time: Optional[float] = None, 
     (default: a local Ray instance, started on the loopback interface if none is running). progress: a
     callable given the fraction done, or True for a bar on stderr. local=True runs the same ranges in this
     process, without Ray: the image a cluster must match to the bit.
+
+    checkpoint: a file for the render's state (the CLI's OUT.exr.checkpoint). checkpoint_every: seconds;
+    at the end of a round, once that long has passed since the last save (or the start), the sums and the
+    merged integrator state are saved there (0: after every round), and again when the render is stopped
+    (Ctrl-C) or its time is up; on_checkpoint then gets the image so far. resume=True continues the render
+    the checkpoint holds (same scene, options, seed, workers and budget; RuntimeError naming what differs
+    otherwise) to the same image, to the bit, as an uninterrupted render. The checkpoint of a render that
+    reached its sample count is left for the caller to remove (distributed_checkpoint.remove) once the
+    image is safely written.
     """
     if spp is not None and time is not None:
         raise ValueError("give spp or time, not both")
@@ -203,6 +227,10 @@ def render(scene_path, spp: Optional[int] = None, time: Optional[float] = None, 
         raise ValueError("workers and threads must be at least 1")
     if time is not None and not time > 0:
         raise ValueError(f"time must be positive, got {time}")
+    if (resume or checkpoint_every is not None) and not checkpoint:
+        raise ValueError("resume and checkpoint_every need the checkpoint's file (checkpoint=...)")
+    if checkpoint_every is not None and not checkpoint_every >= 0:
+        raise ValueError(f"checkpoint_every must be 0 or more seconds, got {checkpoint_every}")
     path = os.path.abspath(os.fspath(scene_path))
     params = {k: option_text(v) for k, v in params.items()}
     scene = load(path, **params)  # errors in the scene surface here, before any worker starts
@@ -216,6 +244,8 @@ def render(scene_path, spp: Optional[int] = None, time: Optional[float] = None, 
     total = spp if spp is not None else (None if time is not None else scene.spp)
     if total is not None and total < 1:
         raise ValueError(f"spp must be at least 1, got {total}")
+    ident = dc.identity(scene, name, opts, seed, sampler, params, workers, total) if checkpoint else ""
+    resumed = dc.resume(checkpoint, ident) if resume else None  # refused here, before any worker starts
     bar = _Bar(progress)
     t0 = _time.monotonic()
     runner = _Local() if local else _Ray(address, workers, threads)
@@ -223,81 +253,112 @@ def render(scene_path, spp: Optional[int] = None, time: Optional[float] = None, 
     def task(first, last, state):
         return runner.submit(path, params, name, opts, first, last, seed, threads, sampler, state)
 
-    results = []
-    done_spp = [0]
+    if resumed:  # where the rounds stood after the last round saved
+        sums = dc.RoundSums.from_checkpoint(resumed)
+        at = json.loads(resumed["driver"])["rounds"]
+        state, learns, rounds = resumed["integrator_state"], at["learns"], at["rounds"]
+        next_start, size, seconds_per_spp = at["next_start"], at["size"], resumed["seconds_per_spp"]
+        time_before = resumed["render_time_s"]
+    else:
+        sums, state, learns, rounds, next_start, size, seconds_per_spp = dc.RoundSums(), b"", False, 0, 0, 1, 0.0
+        time_before = 0.0
+    resumed_spp = sums.spp
+
+    def elapsed():
+        return time_before + _time.monotonic() - t0
+
+    done_spp = [sums.spp]
 
     def fraction():
         if total is None:
-            return (_time.monotonic() - t0) / time
+            return elapsed() / time
         return done_spp[0] / total
 
     def on_done(r):
         done_spp[0] += r["last"] - r["first"]
         bar(fraction())
 
-    first = runner.wait([task(0, 1, b"")], on_done)[0]
-    results.append(first)
-    state = first["integrator_state"]
-    learns = len(state) > 0
-    seconds_per_spp = first["wall_s"]  # per worker: every worker renders every pixel
-    rounds = 1
-    if total is not None:
-        plan = schedule_rounds(total, workers, learns)
-    else:
-        plan = None
-    next_start, size = 1, 1
-    while True:
-        if plan is not None:
-            if rounds - 1 >= len(plan):
-                break
-            ranges = plan[rounds - 1]
-        else:  # time: rounds sized to what is left, growing as for spp while learning
-            left = time - (_time.monotonic() - t0)
-            per = int(left / max(seconds_per_spp, 1e-6) * 0.9)
-            if learns:
-                per = min(per, size)
-                size *= 2
-            if per < 1:
-                break
-            ranges = [(next_start + i * per, next_start + (i + 1) * per) for i in range(workers)]
-            next_start += workers * per
+    saved = {"rounds": rounds, "at": _time.monotonic()}  # a resumed render's rounds are in its checkpoint
+
+    def save():
+        dc.save(checkpoint, ident, sums, state, elapsed(), seconds_per_spp,
+                {"rounds": rounds, "next_start": next_start, "size": size, "learns": learns})
+        saved.update(rounds=rounds, at=_time.monotonic())
+        if on_checkpoint:
+            on_checkpoint(_neepp.image_from_sums(scene, sums.image_sums, sums.splat_sums, sums.light_paths)[..., :3])
+
+    def run_round(ranges):
+        nonlocal state, learns, rounds, next_start, size, seconds_per_spp, committing
         round_t0 = _time.monotonic()
         out = runner.wait([task(a, b, state) for a, b in ranges], on_done)
-        seconds_per_spp = (_time.monotonic() - round_t0) / max(b - a for a, b in ranges)
-        results.extend(out)
-        if learns:
-            state = _neepp.merge_states(name, opts, state, [r["integrator_state"] for r in out])
+        if rounds == 0:
+            learned = out[0]["integrator_state"]
+            learns = len(learned) > 0
+            seconds_per_spp = out[0]["wall_s"]  # per worker: every worker renders every pixel
+        else:
+            learned = _neepp.merge_states(name, opts, state, [r["integrator_state"] for r in out]) if learns else state
+            seconds_per_spp = (_time.monotonic() - round_t0) / max(b - a for a, b in ranges)
+        # The round counts once all of it is in: a stop (Ctrl-C) in between saves the round before.
+        committing = True
+        sums.add(out)
+        state = learned
+        if rounds > 0 and learns:
+            size *= 2
         rounds += 1
+        next_start = ranges[-1][1]
+        committing = False
+
+    saving = checkpoint is not None and checkpoint_every is not None
+    committing = False
+    plan = None
+    try:
+        if rounds == 0:
+            run_round([(0, 1)])
+        plan = schedule_rounds(total, workers, learns) if total is not None else None
+        if plan is not None and not _round_ends_at(plan, rounds, next_start):
+            raise RuntimeError(f"checkpoint '{checkpoint}': its rounds do not fit this render's; it is damaged")
+        while True:
+            if plan is not None and rounds - 1 >= len(plan):
+                break
+            if saving and _time.monotonic() - saved["at"] >= checkpoint_every and saved["rounds"] != rounds:
+                save()
+            if plan is not None:
+                ranges = plan[rounds - 1]
+            else:  # time: rounds sized to what is left, growing as for spp while learning
+                per = int((time - elapsed()) / max(seconds_per_spp, 1e-6) * 0.9)
+                if learns:
+                    per = min(per, size)
+                if per < 1:
+                    break
+                ranges = [(next_start + i * per, next_start + (i + 1) * per) for i in range(workers)]
+            run_round(ranges)
+    except KeyboardInterrupt:
+        if saving and not committing and saved["rounds"] != rounds and sums.ranges:
+            save()
+        raise
+    stopped_by = "spp" if total is not None else "time"
+    if saving and stopped_by == "time" and saved["rounds"] != rounds:  # stopped before its end: kept
+        save()
     bar(1.0)
-    return _merge(scene, results, time_s=_time.monotonic() - t0, workers=workers, rounds=rounds,
-                  address=address, local=local, stopped_by="spp" if total is not None else "time")
+    return _merge(scene, sums, time_s=elapsed(), workers=workers, rounds=rounds, address=address, local=local,
+                  stopped_by=stopped_by, resumed_spp=resumed_spp)
 
 
-def _merge(scene, results: List[dict], time_s: float, workers: int, rounds: int, address, local: bool,
-           stopped_by: str):
-    """The image and statistics of all ranges: sums added in range order (so the same ranges give the same
-    bits however they were spread), the image formed once."""
-    results = sorted(results, key=lambda r: r["first"])
-    image_sums = np.zeros_like(results[0]["image_sums"])
-    splat_sums = np.zeros_like(results[0]["splat_sums"])
-    light_paths = 0.0
-    for r in results:
-        image_sums += r["image_sums"]
-        splat_sums += r["splat_sums"]
-        light_paths += r["light_paths"]
-    image = _neepp.image_from_sums(scene, image_sums, splat_sums, light_paths)
-    per_range = [json.loads(r["stats"]) for r in results]
-    spp = sum(r["last"] - r["first"] for r in results)
-    stats = dict(per_range[-1])
-    for key in _SUMMED:
-        stats[key] = sum(s.get(key, 0) for s in per_range)
-    stats.update(spp=spp, passes=sum(s["passes"] for s in per_range), render_time_s=time_s,
+def _merge(scene, sums: "dc.RoundSums", time_s: float, workers: int, rounds: int, address, local: bool,
+           stopped_by: str, resumed_spp: int):
+    """The image and statistics of all ranges: their sums (added in range order, so the same ranges give the
+    same bits however they were spread), the image formed once."""
+    image = _neepp.image_from_sums(scene, sums.image_sums, sums.splat_sums, sums.light_paths)
+    spp = sums.spp
+    stats = dict(sums.last_stats)
+    stats.update(sums.summed)
+    stats.update(spp=spp, passes=sums.passes, render_time_s=time_s,
                  samples_per_s=spp * scene.width * scene.height / time_s if time_s > 0 else 0.0,
-                 stopped_by=stopped_by, threads=None)
-    stats["integrator"] = per_range[0]["integrator"]
-    stats["distributed"] = {"workers": workers, "rounds": rounds, "ranges": [[r["first"], r["last"]] for r in results],
+                 stopped_by=stopped_by, threads=None, resumed_spp=resumed_spp)
+    stats["integrator"] = sums.first_stats["integrator"]
+    stats["distributed"] = {"workers": workers, "rounds": rounds, "ranges": sums.ranges,
                             "address": address or ("in-process" if local else "local"),
-                            "worker_render_time_s": sum(r["wall_s"] for r in results)}
+                            "worker_render_time_s": sums.worker_render_time_s}
     return image[..., :3], stats
 
 
@@ -321,15 +382,18 @@ def main(argv=None) -> int:
     ap.add_argument("-q", "--quiet", action="store_true")
     ap.add_argument("--ray", nargs="?", const="", default="", metavar="ADDRESS")
     ap.add_argument("--workers", type=int, default=2)
-    for unsupported in ["--checkpoint", "--snapshots", "--visibility-map", "--rfilter", "--display-server"]:
+    ap.add_argument("--checkpoint", type=float, metavar="SECONDS",
+                    help="at the end of a round, once SECONDS have passed since the last save, save the render's "
+                         "state to OUTPUT.checkpoint and write the image so far; also when stopped")
+    ap.add_argument("--resume", action="store_true", help="continue the render saved in OUTPUT.checkpoint")
+    for unsupported in ["--snapshots", "--visibility-map", "--rfilter", "--display-server"]:
         ap.add_argument(unsupported, help=argparse.SUPPRESS)
-    ap.add_argument("--resume", action="store_true", help=argparse.SUPPRESS)
     a = ap.parse_args(argv)
-    for name in ["checkpoint", "snapshots", "visibility_map", "rfilter", "display_server"]:
+    for name in ["snapshots", "visibility_map", "rfilter", "display_server"]:
         if getattr(a, name) is not None:
             ap.error(f"--{name.replace('_', '-')} is not available with --ray")
-    if a.resume:
-        ap.error("--resume is not available with --ray")
+    if a.checkpoint is not None and not a.checkpoint > 0:
+        ap.error(f"--checkpoint: {a.checkpoint} is not a positive number of seconds")
 
     def pairs(items, flag):
         out = {}
@@ -351,28 +415,56 @@ def main(argv=None) -> int:
     params = pairs(a.D, "-D")
     params.pop("spp", None)  # the sample count is --spp's (neepp.load's keywords cannot be spp or time)
     params.pop("time", None)
+    png = os.path.splitext(a.output)[0] + ".png"
+
+    def write_images(image):
+        write_exr(a.output, image)
+        write_png(png, image)
+
+    # --checkpoint and --resume as the CLI's: OUTPUT.checkpoint, saved at round ends (the image so far
+    # written with it), continued by the same command with --resume, removed once the image is written.
+    checkpoint = a.output + ".checkpoint"
+    stopped_by = []
+
+    def on_sigterm(signum, frame):  # stops as Ctrl-C does: the rounds completed are saved
+        stopped_by.append(signum)
+        raise KeyboardInterrupt
+
+    signal.signal(signal.SIGTERM, on_sigterm)
     try:
         image, stats = render(a.scene, spp=a.spp, time=a.time, workers=a.workers, address=a.ray or None,
                               integrator=a.integrator, options=pairs(a.I, "-I"), seed=a.seed, threads=a.threads,
                               sampler=a.sampler, progress=None if a.quiet else sys.stderr.isatty() or
-                              _LogLines(), **params)
+                              _LogLines(), checkpoint=checkpoint if a.checkpoint or a.resume else None,
+                              checkpoint_every=a.checkpoint, resume=a.resume,
+                              on_checkpoint=write_images if a.checkpoint else None, **params)
     except (ValueError, RuntimeError, OSError) as e:
         print(f"neepp: error: {e}", file=sys.stderr)
         return 1
     except KeyboardInterrupt:
-        print("neepp: interrupted (a distributed render keeps no partial image)", file=sys.stderr)
-        return 130
-    write_exr(a.output, image)
-    png = os.path.splitext(a.output)[0] + ".png"
-    write_png(png, image)
+        if a.checkpoint and os.path.exists(checkpoint):
+            print(f"neepp: stopped; the rounds completed are in {checkpoint} (the same command with --resume "
+                  "continues it)", file=sys.stderr)
+        else:
+            print("neepp: interrupted (a distributed render without --checkpoint keeps no partial image)",
+                  file=sys.stderr)
+        return 143 if stopped_by else 130
+    signal.signal(signal.SIGTERM, signal.SIG_DFL)
+    write_images(image)
     if a.stats:
-        with open(a.stats, "w") as f:
-            json.dump(stats, f, indent=2)
-            f.write("\n")
+        _neepp.write_file_atomically(a.stats, lambda tmp: _write_json(tmp, stats))
+    if (a.checkpoint or a.resume) and stats["stopped_by"] == "spp":
+        dc.remove(checkpoint)
     if not a.quiet:
         print(f"neepp: {stats['spp']} spp on {a.workers} workers in {stats['render_time_s']:.2f} s "
               f"({stats['samples_per_s'] * 1e-6:.3f} M samples/s), wrote {a.output} and {png}", file=sys.stderr)
     return 0
+
+
+def _write_json(path: str, data: dict) -> None:
+    with open(path, "w") as f:
+        json.dump(data, f, indent=2)
+        f.write("\n")
 
 
 class _LogLines:

@@ -20,6 +20,18 @@ std::string temporary_name(const std::string &path) {
     return (p.parent_path() / fmt::format(".{}.{}.tmp", p.filename().string(), getpid())).string();
 }
 
+// fsync, so that the rename cannot reach the disk before the data does (after a crash the name would
+// then point to an empty file on some file systems).
+bool flush_to_disk(const std::string &file) {
+    const int fd = ::open(file.c_str(), O_RDONLY);
+    if (fd < 0) return false;
+    const bool ok = ::fsync(fd) == 0;
+    ::close(fd);
+    return ok;
+}
+
+}  // namespace
+
 // Temporaries of this output that a process killed while writing (SIGKILL, a power cut) left behind:
 // removed when the output is next written. Only those whose process is gone: a live one (another render
 // writing the same output, this one's other threads) may still be writing its own.
@@ -42,18 +54,6 @@ void remove_stale_temporaries(const std::string &path) {
         std::filesystem::remove(it->path(), ignored);
     }
 }
-
-// fsync, so that the rename cannot reach the disk before the data does (after a crash the name would
-// then point to an empty file on some file systems).
-bool flush_to_disk(const std::string &file) {
-    const int fd = ::open(file.c_str(), O_RDONLY);
-    if (fd < 0) return false;
-    const bool ok = ::fsync(fd) == 0;
-    ::close(fd);
-    return ok;
-}
-
-}  // namespace
 
 void write_file_atomically(const std::string &path, const std::function<void(const std::string &)> &write) {
     const std::string tmp = temporary_name(path);

@@ -16,4 +16,8 @@ void write_file_atomically(const std::string &path, const std::function<void(con
 // The same for a file whose whole content is in memory (statistics JSON, visibility maps).
 void write_file_atomically(const std::string &path, const std::string &content);
 
+// Removes the temporaries of path that processes no longer running left (as each write does first): for
+// a file that is removed rather than written again (a finished render's checkpoint).
+void remove_stale_temporaries(const std::string &path);
+
 }  // namespace neepp

@@ -10,13 +10,14 @@ namespace neepp {
 namespace {
 
 constexpr char kMagic[8] = {'N', 'E', 'E', 'P', 'P', 'C', 'K', 'P'};
-// Version 2: the counters gained the media counters (density and transmittance lookups).
-constexpr uint32_t kVersion = 2;
+// Version 2: the counters gained the media counters (density and transmittance lookups). Version 3: the
+// driver's part (distributed renders); a version 2 file reads as a checkpoint without one.
+constexpr uint32_t kVersion = 3;
 static_assert(std::is_trivially_copyable_v<RenderCounters>);
 
 }  // namespace
 
-void save_checkpoint(const std::string &path, const RenderCheckpoint &c) {
+std::string checkpoint_bytes(const RenderCheckpoint &c) {
     BinaryWriter w;
     w.bytes.append(kMagic, 8);
     w.put(kVersion);
@@ -30,9 +31,14 @@ void save_checkpoint(const std::string &path, const RenderCheckpoint &c) {
     w.put_vector(c.image_sums);
     w.put_vector(c.splat_sums);
     w.put_string(c.integrator_state);
+    w.put_string(c.driver);
     w.put(fnv1a64(w.bytes.data(), w.bytes.size()));
+    return std::move(w.bytes);
+}
+
+void save_checkpoint(const std::string &path, const RenderCheckpoint &c) {
     try {
-        write_file_atomically(path, w.bytes);
+        write_file_atomically(path, checkpoint_bytes(c));
     } catch (const std::exception &e) {
         throw std::runtime_error(fmt::format("checkpoint {}", e.what()));
     }
@@ -49,8 +55,9 @@ RenderCheckpoint load_checkpoint(const std::string &path) {
         throw std::runtime_error(what + ": checksum mismatch: the file is damaged");
     const std::string body = bytes.substr(0, bytes.size() - 8);
     BinaryReader r{body, 8, what};
-    if (const uint32_t version = r.get<uint32_t>(); version != kVersion)
-        throw std::runtime_error(fmt::format("{}: unsupported version {} (this build reads version {})", what, version, kVersion));
+    const uint32_t version = r.get<uint32_t>();
+    if (version != kVersion && version != 2)
+        throw std::runtime_error(fmt::format("{}: unsupported version {} (this build reads versions 2 to {})", what, version, kVersion));
     RenderCheckpoint c;
     c.identity = r.get_string();
     c.spp = r.get<int32_t>();
@@ -62,6 +69,7 @@ RenderCheckpoint load_checkpoint(const std::string &path) {
     c.image_sums = r.get_vector<double>();
     c.splat_sums = r.get_vector<int64_t>();
     c.integrator_state = r.get_string();
+    if (version >= 3) c.driver = r.get_string();
     if (r.pos != body.size() || c.spp < 1 || c.passes < 1) throw std::runtime_error(what + ": malformed");
     return c;
 }

@@ -23,9 +23,14 @@ struct RenderCheckpoint {
     std::vector<double> image_sums;   // ImageBlock::sums() of the whole image
     std::vector<int64_t> splat_sums;  // SplatFilm::sums(); empty for integrators that do not splat
     std::string integrator_state;     // Integrator::save_state()
+    // A distributed render's driver (neepp.distributed): where its rounds stand and the statistics of the
+    // ranges summed so far, as JSON it alone reads. Empty for a render of one machine.
+    std::string driver;
 };
 
-// Writes the checkpoint atomically (see atomic_file.h), with a checksum.
+// The checkpoint as its file holds it, with a checksum.
+std::string checkpoint_bytes(const RenderCheckpoint &checkpoint);
+// Writes the checkpoint atomically (see atomic_file.h).
 void save_checkpoint(const std::string &path, const RenderCheckpoint &checkpoint);
 // Reads one back; throws std::runtime_error naming the file when it is missing, damaged or not one.
 RenderCheckpoint load_checkpoint(const std::string &path);
