@@ -65,8 +65,8 @@ std::vector<IntegratorDoc> make_docs() {
                             "shading voxel by the visibility map)", ""});
     const std::string area_light_sampling =
         "how a point on a chosen area light is drawn: area (uniform in area, as Mitsuba 3) or solid-angle "
-        "(rectangles and spheres uniform in the solid angle they subtend, as pbrt-v4 and Cycles; other shapes "
-        "by area)";
+        "(uniform in the solid angle it subtends, as pbrt-v4 and Cycles: spheres from outside, rectangles from "
+        "within half their diagonal; elsewhere and other shapes by area; docs/neepp.md)";
     path.options.push_back({"area_light_sampling", p.area_light_sampling, area_light_sampling, ""});
     path.options.push_back({"ris", text(p.ris),
                             "resampled NEE: M light-sample candidates per vertex, one chosen by f*Le*max(sqrt(V~), "
