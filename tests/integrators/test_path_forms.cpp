@@ -80,10 +80,12 @@ const Family kFamilies[] = {
     {"two rooms", [] { return two_rooms_xml(false); }},
     {"window room", [] { return window_room_xml(); }},
     {"sky", sky_scene_xml},
+    {"lamps", lamps_xml},
 };
 
 // The options the other tests render with: plain NEE and BSDF sampling alone, path lengths, every light
-// sampler, every NEE++ shadow-ray policy, sampling within the sky, resampled NEE.
+// sampler, every NEE++ shadow-ray policy, sampling within the sky, solid-angle sampling of area lights
+// (which the fast form takes through the scalar sampler, not the rectangle lanes), resampled NEE.
 const std::vector<OptionMap> kOptionSets = {
     {},
     {{"nee", "false"}},
@@ -98,6 +100,8 @@ const std::vector<OptionMap> kOptionSets = {
     {{"shadow_rays", "neepp-adaptive"}},
     {{"shadow_rays", "neepp-cv"}},
     {{"within_light", "visibility"}},
+    {{"area_light_sampling", "solid-angle"}},
+    {{"area_light_sampling", "solid-angle"}, {"ris", "4"}, {"light_sampler", "power"}},
     {{"ris", "4"}},
     {{"ris", "4"}, {"ris_depth", "-1"}},
     {{"ris", "8"}, {"ris_depth", "3"}, {"shadow_rays", "neepp"}, {"light_sampler", "power"}},
@@ -223,6 +227,7 @@ TEST(PathForms, SameImageInExpectation) {
         {2, {{"light_sampler", "visibility"}}}, {2, {{"shadow_rays", "neepp"}, {"ris", "4"}}},
         {3, {{"shadow_rays", "neepp"}}}, {4, {{"shadow_rays", "neepp-adaptive"}}},
         {5, {{"within_light", "visibility"}}}, {5, {{"max_depth", "-1"}, {"rr_depth", "1"}}},
+        {6, {{"area_light_sampling", "solid-angle"}}}, {0, {{"area_light_sampling", "solid-angle"}}},
     };
     for (auto [family, o] : cases) {
         const std::string what = describe(kFamilies[family], o);

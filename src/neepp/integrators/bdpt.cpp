@@ -76,6 +76,7 @@ void BDPTIntegrator::prepare(const Scene &scene) {
     ctx_.scene = &scene;
     ctx_.camera = &scene.camera;
     ctx_.lights = light_sampler_.get();
+    area_lights_ = WithinLightSampling("own", scene, nullptr, nullptr, options_.area_light_sampling);
     ctx_.disk_pdf = SceneSphere(scene.bounds()).disk_pdf();
     pool_.clear();
     pool_cells_.clear();
@@ -102,6 +103,7 @@ nlohmann::json BDPTIntegrator::describe() const {
     if (!options_.light_tracer) {
         j["mis"] = options_.power_heuristic ? "power" : "balance";
         j["light_paths"] = options_.neepp_selection ? "neepp" : "independent";
+        j["area_light_sampling"] = options_.area_light_sampling;
         if (options_.neepp_selection) {
             j["candidates"] = options_.candidates;
             j["pool"] = options_.pool;
@@ -209,7 +211,12 @@ Color BDPTIntegrator::connect(const std::vector<PathVertex> &light, const std::v
         const Vec2 u = sampler.next_2d();
         if (!sl.light || !(sl.pmf > 0)) return Color(0.f);
         Color Le;
-        const DirectionSample ds = sl.light->sample_direction(pt.p, u, Le);
+        // Its weight divides by the density it was drawn with; its MIS weight (below) takes the light vertex's
+        // density as light subpaths draw it (by area), as pbrt-v4's does: the weights of every strategy still
+        // sum to one, and with solid-angle sampling that density is not this one's (slightly worse weights,
+        // never a bias).
+        const ContextLightSampler *within = area_lights_.for_light(*sl.light);
+        const DirectionSample ds = within ? within->sample({pt.p, pt.n}, u, Le) : sl.light->sample_direction(pt.p, u, Le);
         if (!(ds.pdf > 0) || is_black(Le)) return Color(0.f);
         sampled = PathVertex{};
         sampled.kind = VertexKind::Light;

@@ -25,6 +25,7 @@
 #include <vector>
 #include "neepp/base/integrator.h"
 #include "neepp/integrators/path_vertex.h"
+#include "neepp/light_selection/within_light_sampling.h"
 #include "neepp/visibility/shadow_ray_tester.h"
 
 namespace neepp {
@@ -42,6 +43,9 @@ struct BDPTOptions {
     int candidates = 8;                    // K
     int pool = 4096;                       // M
     int voxels = 16;
+    // How the s = 1 strategies sample a point on the light they chose: area or solid-angle
+    // (light_selection/solid_angle_sampling.h).
+    std::string area_light_sampling = "area";
 };
 
 class BDPTIntegrator final : public SplattingIntegrator {
@@ -93,6 +97,8 @@ private:
     std::unique_ptr<ShadowRayTester> shadow_;
     const ShadowRayTester *queries_ = nullptr;
     std::unique_ptr<LightSampler> light_sampler_;
+    // How s = 1 samples a point of the light it chose (null for a light: by its own sampling).
+    WithinLightSampling area_lights_;
     BidirContext ctx_;
     // NEE++ pool of the coming pass: light subpaths and their vertices' voxels.
     std::vector<std::vector<PathVertex>> pool_;

@@ -49,6 +49,14 @@ std::unique_ptr<ShadowRayTester> make_shadow_ray_tester(const Options &options, 
 
 namespace {
 
+std::string read_area_light_sampling(const Options &options) {
+    const std::string s = options.get_string("area_light_sampling", "area");
+    const auto &names = WithinLightSampling::area_light_names();
+    if (std::find(names.begin(), names.end(), s) == names.end())
+        throw std::invalid_argument("area_light_sampling must be 'area' or 'solid-angle', not '" + s + "'");
+    return s;
+}
+
 std::unique_ptr<Integrator> make_bdpt(bool light_tracer, const Options &options) {
     BDPTOptions o;
     o.light_tracer = light_tracer;
@@ -76,6 +84,7 @@ std::unique_ptr<Integrator> make_bdpt(bool light_tracer, const Options &options)
         if (lp != "independent" && lp != "neepp")
             throw std::invalid_argument("light_paths must be 'independent' or 'neepp'");
         o.neepp_selection = lp == "neepp";
+        o.area_light_sampling = read_area_light_sampling(options);
         if (o.neepp_selection) {
             o.candidates = options.get_int("candidates", o.candidates);
             o.pool = options.get_int("pool", o.pool);
@@ -107,6 +116,7 @@ std::unique_ptr<PathIntegrator> make_path(const Options &options, bool volumetri
     const auto &within = WithinLightSampling::names();
     if (std::find(within.begin(), within.end(), o.within_light) == within.end())
         throw std::invalid_argument("within_light must be 'own' or 'visibility', not '" + o.within_light + "'");
+    o.area_light_sampling = read_area_light_sampling(options);
     if (o.max_depth < -1 || o.max_depth == 0) throw std::invalid_argument("max_depth must be -1 or >= 1");
     if (o.rr_depth < 1) throw std::invalid_argument("rr_depth must be >= 1");
     if (!volumetric) o.ris = options.get_int("ris", o.ris);

@@ -63,6 +63,11 @@ std::vector<IntegratorDoc> make_docs() {
     path.options.push_back({"within_light", p.within_light,
                             "where on it: own (the light's own sampling) or visibility (environment maps per "
                             "shading voxel by the visibility map)", ""});
+    const std::string area_light_sampling =
+        "how a point on a chosen area light is drawn: area (uniform in area, as Mitsuba 3) or solid-angle "
+        "(uniform in the solid angle it subtends, as pbrt-v4 and Cycles: spheres from outside, rectangles from "
+        "within half their diagonal; elsewhere and other shapes by area; docs/neepp.md)";
+    path.options.push_back({"area_light_sampling", p.area_light_sampling, area_light_sampling, ""});
     path.options.push_back({"ris", text(p.ris),
                             "resampled NEE: M light-sample candidates per vertex, one chosen by f*Le*max(sqrt(V~), "
                             "ris_floor) for the shadow ray (1: plain NEE; keeps a visibility map)", ""});
@@ -87,6 +92,7 @@ std::vector<IntegratorDoc> make_docs() {
     bdpt.options.push_back({"mis", "power", "MIS heuristic: power or balance", ""});
     bdpt.options.push_back({"strategy", "", "render only strategy S,T (s light and t camera vertices)", ""});
     bdpt.options.push_back({"strategy_weight", "mis", "that strategy MIS-weighted (mis) or unweighted (none)", "strategy=S,T"});
+    bdpt.options.push_back({"area_light_sampling", b.area_light_sampling, area_light_sampling + ", for s = 1", ""});
     bdpt.options.push_back({"light_paths", "independent", "independent, or neepp: NEE++ light-subpath selection", ""});
     bdpt.options.push_back({"candidates", text(b.candidates), "K light subpaths a camera subpath chooses among", "light_paths=neepp"});
     bdpt.options.push_back({"pool", text(b.pool), "M light subpaths traced before each pass", "light_paths=neepp"});

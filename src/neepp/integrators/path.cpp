@@ -39,7 +39,8 @@ void PathIntegrator::prepare(const Scene &scene) {
     queries_ = &shadow_->query_tester();
     LightSelectionInputs inputs{&scene, shadow_->voxel_grid(), shadow_->visibility_map(), options_.voxels};
     light_sampler_ = make_light_sampler(options_.light_sampler, scene.light_pointers(), inputs);
-    within_light_ = WithinLightSampling(options_.within_light, scene, shadow_->voxel_grid(), shadow_->visibility_map());
+    within_light_ = WithinLightSampling(options_.within_light, scene, shadow_->voxel_grid(), shadow_->visibility_map(),
+                                        options_.area_light_sampling);
     refresh_resampling();
 }
 
@@ -85,6 +86,7 @@ nlohmann::json PathIntegrator::describe() const {
             {"nee", options_.nee},
             {"light_sampler", options_.light_sampler},
             {"within_light", options_.within_light},
+            {"area_light_sampling", options_.area_light_sampling},
             {"ris", options_.ris},
             {"ris_floor", options_.ris_floor},
             {"ris_depth", options_.ris_depth},

@@ -19,6 +19,7 @@ struct PathOptions {
     bool nee = true;
     std::string light_sampler = "bvh";  // pbrt-v4's default too; the best of the non-NEE++ choices (docs/neepp.md)
     std::string within_light = "own";  // how a point on the chosen light is sampled (WithinLightSampling)
+    std::string area_light_sampling = "area";  // area or solid-angle (light_selection/solid_angle_sampling.h)
     int voxels = 16;  // grid of the spatial light sampler when NEE++ keeps no map (else the map's grid)
     // Resampled NEE (light_selection/resampling.h): ris light-sample candidates per vertex, one chosen by
     // f·Le·max(√Ṽ, ris_floor) for the shadow ray (1 = plain NEE), at the path's first ris_depth vertices

@@ -151,8 +151,12 @@ void PathBatch::sample_light(Path &path, LightSampleLanes &lanes) const {
             continue;
         }
         any = true;
-        if (c.within)
-            c.sample.ds = c.within->finish(path.ctx, c.start, c.sample.radiance);
+        if (c.within) {
+            if (const LightLaneRecord *record = c.within->own_lane_record(path.ctx))
+                lanes.add(*record, path.si.p, c.start.u, c.sample);
+            else
+                c.sample.ds = c.within->finish(path.ctx, c.start, c.sample.radiance);
+        }
         else if (const LightLaneRecord *record = sl.light->lane_record())
             lanes.add(*record, path.si.p, c.start.u, c.sample);
         else if (c.steps)

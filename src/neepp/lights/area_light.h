@@ -27,6 +27,10 @@ public:
     // The shape's box, its normal bounds, one-sided cosine emission.
     std::optional<LightBounds> bounds() const override;
     const Shape *shape() const { return shape_; }
+    // The radiance its front emits at a point of the shape (its uv and normal as a ray hit there fills
+    // them): what other samplers of its points (light_selection/solid_angle_sampling.h) carry.
+    bool uniform() const { return constant_; }
+    Color radiance_at(const SurfaceInteraction &si) const { return constant_ ? constant_radiance_ : radiance_->eval(si); }
     // A parallelogram of constant radiance is sampled in lanes too (lane_record()).
     void prepare(const BBox &scene_bounds) override;
 
