@@ -5,15 +5,24 @@
 # and the Python tests (pytest: CLI, the Python package, comparison with Mitsuba 3).
 set -euo pipefail
 ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
+# Each stage's wall time, printed as it ends and summed up at the end: CI's budget is spent by stage.
+TIMES=()
+stage() {
+  local name="$1" t0=$SECONDS
+  shift
+  "$@"
+  TIMES+=("$(printf '%-12s %5d s' "$name" $((SECONDS - t0)))")
+  echo "test.sh: stage $name took $((SECONDS - t0)) s"
+}
 # valgrind: tests/python/test_instructions.py runs bench/instructions.py, which counts instructions with it;
 # chromium: tests/python/test_compare.py opens neepp compare's page in it (headless).
-"$ROOT/scripts/install_deps.sh" valgrind chromium
-"$ROOT/scripts/setup_python.sh"
-"$ROOT/scripts/build.sh"
+stage deps "$ROOT/scripts/install_deps.sh" valgrind chromium
+stage python "$ROOT/scripts/setup_python.sh"
+stage build "$ROOT/scripts/build.sh"
 # The neepp Python package (tests/python/test_package.py, test_distributed.py), installed by pip from build/:
 # the library objects just built are reused (native, as the CLI's), so only the extension module compiles.
 # A user's plain `pip install .` compiles everything again for the x86-64-v2 baseline in build/python-*.
-"$ROOT/.venv/bin/python" -m pip install -q --no-build-isolation -C build-dir=build \
+stage package "$ROOT/.venv/bin/python" -m pip install -q --no-build-isolation -C build-dir=build \
   -C cmake.define.NEEPP_MARCH=native -C cmake.define.NEEPP_TESTS=ON "$ROOT"
 # The instruction-count test runs neepp under valgrind, which cannot run a -march=native build of an
 # AVX-512 CPU: there it gets a build for x86-64-v3. Where valgrind runs the native build (no AVX-512), the
@@ -27,13 +36,15 @@ import instructions
 sys.exit(0 if instructions.valgrind_problem(root / "build" / "neepp") is None else 1)
 PY
 then
-  "$ROOT/scripts/build_valgrind.sh"
+  stage valgrind-build "$ROOT/scripts/build_valgrind.sh"
 fi
-ctest --test-dir "$ROOT/build" --output-on-failure -j2
+stage ctest ctest --test-dir "$ROOT/build" --output-on-failure -j2
 # The C++ tests again under AddressSanitizer + UndefinedBehaviorSanitizer (clang), then each fuzz target
 # of fuzz/ for 10 s: both in build-sanitize/.
-"$ROOT/scripts/test_sanitizers.sh"
+stage sanitizers "$ROOT/scripts/test_sanitizers.sh"
 # ThreadSanitizer over the render loop's and the visibility map's tests, with TBB rebuilt for it.
-"$ROOT/scripts/test_tsan.sh"
-"$ROOT/scripts/fuzz.sh" 10
-cd "$ROOT" && NEEPP_BIN="$ROOT/build/neepp" "$ROOT/.venv/bin/python" -m pytest tests/python -q -rs --durations=30
+stage tsan "$ROOT/scripts/test_tsan.sh"
+stage fuzz "$ROOT/scripts/fuzz.sh" 10
+cd "$ROOT"
+NEEPP_BIN="$ROOT/build/neepp" stage pytest "$ROOT/.venv/bin/python" -m pytest tests/python -q -rs --durations=30
+printf 'test.sh: %s\n' "${TIMES[@]}"
