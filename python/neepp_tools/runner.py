@@ -260,7 +260,9 @@ def run_mitsuba(scene, out_exr=None, *, variant: str = "llvm_ad_rgb", resx: int 
             return RenderResult(img, stats, 0.0, stats.get("peak_rss_mb", float("nan")),
                                 Path(out_exr) if out_exr else c_exr, cached=True)
         if out_exr is None:
-            out_exr = c_exr
+            # Rendered beside the cache under a name of this process, then moved into place: two test
+            # processes (pytest -n) asking for the same render each write whole files, never half of one.
+            out_exr = cache_dir / f".{key}.{os.getpid()}.exr"
     if out_exr is None:
         raise ValueError("out_exr is required without cache")
     out_exr = Path(out_exr)
@@ -298,7 +300,14 @@ def run_mitsuba(scene, out_exr=None, *, variant: str = "llvm_ad_rgb", resx: int 
     stats["peak_rss_mb"] = rss
     if cache_dir is not None:
         cache_dir.mkdir(parents=True, exist_ok=True)
-        if out_exr != c_exr:
-            shutil.copyfile(out_exr, c_exr)
-        c_json.write_text(json.dumps(stats, indent=2))
+        # The EXR first, then the JSON that marks the entry complete, each by an atomic rename.
+        tmp_exr, tmp_json = (cache_dir / f".{key}.{os.getpid()}.{ext}.tmp" for ext in ("exr", "json"))
+        shutil.copyfile(out_exr, tmp_exr)
+        os.replace(tmp_exr, c_exr)
+        tmp_json.write_text(json.dumps(stats, indent=2))
+        os.replace(tmp_json, c_json)
+        if out_exr.name.startswith(f".{key}."):
+            out_exr.unlink()
+            json_path.unlink(missing_ok=True)
+            out_exr = c_exr
     return RenderResult(read_exr(out_exr), stats, wall, rss, out_exr, out)
