@@ -3,9 +3,9 @@
 # python/neepp_tools, tests/python and bench/: numpy, pytest, matplotlib, pillow, Mitsuba 3
 # (the peer renderer), flip-evaluator (NVIDIA FLIP, for neepp compare), and nanobind and scikit-build-core,
 # with which scripts/test.sh installs the neepp package into it (pip install --no-build-isolation), Ray
-# (neepp.distributed) and aiohttp (neepp view's web server). Also installs libllvm19 (Debian 12 main) for
-# Mitsuba's llvm_ad_rgb variant, which must then be run with DRJIT_LIBLLVM_PATH set (neepp_tools.runner
-# does it).
+# (neepp.distributed), aiohttp (neepp view's web server) and pytest-xdist (scripts/test.sh runs pytest
+# in two workers). Also installs libllvm19 (Debian 12 main) for Mitsuba's llvm_ad_rgb variant, which must
+# then be run with DRJIT_LIBLLVM_PATH set (neepp_tools.runner does it).
 # Idempotent; safe to rerun. Usage: scripts/setup_python.sh [VENV_DIR]
 set -euo pipefail
 
@@ -25,6 +25,7 @@ REQS=(
   "scikit-build-core>=0.10"
   "ray>=2.9"
   "aiohttp>=3.9"
+  "pytest-xdist>=3.5"
 )
 
 # libllvm19 for the llvm variant (LLVM 14/15 make Dr.Jit abort). Skip apt when present.
@@ -45,14 +46,14 @@ if "$VENV/bin/python" - "${REQS[@]}" <<'PY' 2>/dev/null
 import sys
 from importlib.metadata import version
 want = {"numpy": None, "pytest": None, "matplotlib": None, "pillow": None, "mitsuba": "3.9.", "flip-evaluator": None,
-        "nanobind": None, "scikit-build-core": None, "ray": None, "aiohttp": None}
+        "nanobind": None, "scikit-build-core": None, "ray": None, "aiohttp": None, "pytest-xdist": None}
 for name, prefix in want.items():
     v = version(name)
     if prefix and not v.startswith(prefix):
         sys.exit(1)
 PY
 then
-  echo "setup_python: $VENV already has numpy, pytest, matplotlib, pillow, mitsuba 3.9, flip-evaluator, nanobind, scikit-build-core, ray, aiohttp"
+  echo "setup_python: $VENV already has numpy, pytest, matplotlib, pillow, mitsuba 3.9, flip-evaluator, nanobind, scikit-build-core, ray, aiohttp, pytest-xdist"
 else
   "$VENV/bin/python" -m pip install -q --upgrade pip
   "$VENV/bin/python" -m pip install -q "${REQS[@]}"

@@ -46,5 +46,8 @@ stage sanitizers "$ROOT/scripts/test_sanitizers.sh"
 stage tsan "$ROOT/scripts/test_tsan.sh"
 stage fuzz "$ROOT/scripts/fuzz.sh" 10
 cd "$ROOT"
-NEEPP_BIN="$ROOT/build/neepp" stage pytest "$ROOT/.venv/bin/python" -m pytest tests/python -q -rs --durations=30
+# Two workers (pytest-xdist): much of a test's time leaves a core idle (Mitsuba's JIT, loading, a process
+# starting, a server waited on). Each module runs in one worker (tests/python/conftest.py).
+NEEPP_BIN="$ROOT/build/neepp" stage pytest "$ROOT/.venv/bin/python" -m pytest tests/python -q -rs --durations=30 \
+  -n 2 --dist loadgroup
 printf 'test.sh: %s\n' "${TIMES[@]}"

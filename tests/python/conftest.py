@@ -51,3 +51,22 @@ def mitsuba_variant() -> str:
 @pytest.fixture(scope="session")
 def work_dir(tmp_path_factory) -> Path:
     return tmp_path_factory.mktemp("vs_mitsuba")
+
+
+# Modules that start a local Ray instance: kept to one pytest-xdist worker, so that two never run at once.
+_RAY_MODULES = {"test_distributed", "test_distributed_checkpoint"}
+
+
+def pytest_configure(config):
+    config.addinivalue_line("markers", "xdist_group(name): tests that pytest-xdist runs in one worker")
+
+
+def pytest_collection_modifyitems(config, items):
+    # scripts/test.sh runs the suite in two pytest-xdist workers (-n 2 --dist loadgroup): much of a test's
+    # time is not on both cores (Mitsuba's JIT, scene loading, a process starting, waiting on a server), so
+    # two at once finish sooner. Each module's tests go to one worker, so that its module fixtures (a Ray
+    # instance, a server, a memoized reference render) start once and its files in .cache/<module>/ have
+    # one writer.
+    for item in items:
+        name = item.module.__name__.rsplit(".", 1)[-1]
+        item.add_marker(pytest.mark.xdist_group("ray" if name in _RAY_MODULES else name))
