@@ -1,7 +1,9 @@
 // neepp.render: the render loop the CLI runs, on a scene loaded in Python. The render runs on a thread of
 // its own with the GIL released, while the calling thread watches it: it forwards the fraction done to the
-// progress callback and turns Ctrl-C (a pending KeyboardInterrupt) into the render loop's cancel, which
-// ends the render with the image of the passes completed, as the CLI does on SIGINT.
+// progress callback and turns Ctrl-C (a pending KeyboardInterrupt) or the callback's False into the render
+// loop's cancel, which ends the render with the image of the passes completed, as the CLI does on SIGINT.
+// The render thread never touches Python: the GIL is free for other Python threads (their own renders
+// included) the whole time, taken back only to call the callback and to check for signals.
 #include <atomic>
 #include <chrono>
 #include <condition_variable>
@@ -41,6 +43,7 @@ RenderJob make_job(const Scene &scene, int spp, double time_s, uint64_t seed, in
 struct Watched {
     RenderResult result;
     bool interrupted = false;  // by Ctrl-C
+    bool cancelled = false;    // by the progress callback's False
 };
 
 // Renders on a thread of its own while this (the Python) thread forwards progress and watches for Ctrl-C.
@@ -85,7 +88,14 @@ Watched render_watched(const Scene &scene, Integrator &integrator, RenderJob job
                     }
                 } else if (callback && !cancel) {
                     try {
-                        progress(fraction.load());
+                        // False (not None, what a callback that returns nothing gives): stop as Ctrl-C
+                        // does, with the image of the passes completed. The one way to stop a render
+                        // running on another Python thread and keep its image, since Ctrl-C reaches the
+                        // main thread only.
+                        if (progress(fraction.load()).is(nb::handle(Py_False))) {
+                            cancel = true;
+                            watched.cancelled = true;
+                        }
                     } catch (nb::python_error &e) {
                         cancel = true;
                         raised.emplace(e);
@@ -135,6 +145,8 @@ nb::dict render_range(const Scene &scene, const std::string &integrator_name,
         PyErr_SetNone(PyExc_KeyboardInterrupt);
         throw nb::python_error();
     }
+    if (w.cancelled && w.result.stopped_by == "cancel")
+        throw std::runtime_error("render_range: stopped by the progress callback before the range was complete");
     RenderCheckpoint &c = w.result.state;
     nb::dict out;
     out["first"] = first;

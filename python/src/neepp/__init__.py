@@ -59,7 +59,11 @@ def render(scene: Scene, spp: Optional[int] = None, time: Optional[float] = None
     seed: the sampler's seed (default: the scene's). threads: worker threads (default: all cores).
     progress: a callable given the fraction done (0..1) a few times a second, or True for the CLI's bar.
     Ctrl-C stops the render and returns the image of the passes completed (stats["stopped_by"] is
-    "cancel"), as the CLI does; an exception raised by the callback stops it and propagates.
+    "cancel"), as the CLI does, and so does the callback returning False (None goes on); an exception
+    raised by the callback stops it and propagates. The callback runs on the calling thread.
+
+    Renders may run on several Python threads at once (the GIL is released while one works), each on
+    its own `threads`, and give the images they give alone (README: "Threads").
     """
     if spp is not None and time is not None:
         raise ValueError("give spp or time, not both")
