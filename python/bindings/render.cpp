@@ -9,6 +9,7 @@
 #include <condition_variable>
 #include <mutex>
 #include <optional>
+#include <set>
 #include <thread>
 #include <nanobind/stl/map.h>
 #include <nanobind/stl/pair.h>
@@ -26,6 +27,47 @@ std::unique_ptr<Integrator> scene_integrator(const Scene &scene, const std::stri
     Options options(scene.settings.integrator_options);
     for (const auto &[key, value] : overrides) options.set(key, value);
     return make_integrator(name.empty() ? scene.settings.integrator : name, options);
+}
+
+namespace {
+
+struct InFlight {
+    std::mutex mutex;
+    std::condition_variable ended;
+    std::set<std::atomic<bool> *> cancels;
+    bool exiting = false;  // set by stop_renders: a render that starts after it stops at once
+};
+InFlight &in_flight() {
+    static InFlight &f = *new InFlight;  // never destroyed: a daemon thread's render may outlive exit's destructors
+    return f;
+}
+
+// neepp's atexit handler: cancels every render under way and waits (GIL released: they may need it to end)
+// until each has returned, or timeout_s. Python runs it before finalization, while daemon threads still
+// run: their renders end with the image so far and nothing is left running into the teardown.
+bool stop_renders(double timeout_s) {
+    InFlight &f = in_flight();
+    nb::gil_scoped_release release;
+    std::unique_lock<std::mutex> lock(f.mutex);
+    f.exiting = true;
+    for (std::atomic<bool> *c : f.cancels) *c = true;
+    return f.ended.wait_for(lock, std::chrono::duration<double>(timeout_s), [&] { return f.cancels.empty(); });
+}
+
+}  // namespace
+
+RenderInFlight::RenderInFlight(std::atomic<bool> &cancel) : cancel_(cancel) {
+    InFlight &f = in_flight();
+    std::lock_guard<std::mutex> lock(f.mutex);
+    f.cancels.insert(&cancel_);
+    if (f.exiting) cancel_ = true;
+}
+
+RenderInFlight::~RenderInFlight() {
+    InFlight &f = in_flight();
+    std::lock_guard<std::mutex> lock(f.mutex);
+    f.cancels.erase(&cancel_);
+    f.ended.notify_all();
 }
 
 namespace {
@@ -61,6 +103,10 @@ Watched render_watched(const Scene &scene, Integrator &integrator, RenderJob job
     std::condition_variable finished;
     bool done = false;
     std::optional<nb::python_error> raised;  // by the callback or a signal handler: ends the render, raised after it
+    // Until this function is back in Python, GIL held: the interpreter's exit must not begin before, since
+    // a daemon thread that takes the GIL after it has begun is ended by pthread_exit, whose unwinding
+    // cannot pass nanobind's GIL guards (noexcept) and aborts the process.
+    const RenderInFlight flight(cancel);
     {
         nb::gil_scoped_release release;
         std::thread worker([&] {
@@ -162,6 +208,9 @@ nb::dict render_range(const Scene &scene, const std::string &integrator_name,
 }  // namespace
 
 void bind_render(nb::module_ &m) {
+    m.def("_stop_renders", &stop_renders, nb::arg("timeout"),
+          "Cancels every render under way and waits up to timeout seconds for them to return (True: all did). "
+          "neepp's atexit handler.");
     using Doubles = nb::ndarray<const double, nb::ndim<1>, nb::c_contig, nb::device::cpu>;
     using Int64s = nb::ndarray<const int64_t, nb::ndim<1>, nb::c_contig, nb::device::cpu>;
     m.def("render_range", &render_range, nb::arg("scene"), nb::arg("integrator"), nb::arg("options"), nb::arg("first"),

@@ -5,6 +5,8 @@ so these threads really run at the same time. Every wait has a timeout: a deadlo
 instead of hanging the suite. Tiny images and few samples: the whole file takes seconds."""
 from __future__ import annotations
 
+import subprocess
+import sys
 import threading
 import time
 from pathlib import Path
@@ -148,3 +150,27 @@ def test_slow_callback_while_the_render_ends(door, office, alone):
                                  lambda: neepp.render(office, **BDPT))
     assert np.array_equal(a, alone["neepp"]) and np.array_equal(b, alone["bdpt"])
     assert slow and slow[-1] == 1.0
+
+
+EXIT_SCRIPT = """
+import sys, threading, neepp
+scene = neepp.load(sys.argv[1], resx=40, resy=28)
+started = threading.Event()
+threading.Thread(target=lambda: neepp.render(scene, time=30, progress=lambda f: started.set()), daemon=True).start()
+assert started.wait(20)
+print("exiting", flush=True)
+"""
+
+
+def test_exit_with_a_render_running_on_a_daemon_thread(tmp_path):
+    # The interpreter exits while a daemon thread renders: neepp's atexit handler stops the render and waits
+    # for it, instead of the thread being ended mid-render by finalization: before the handler existed, an
+    # abort (std::terminate) or a crash in about half the runs, hence four of them.
+    script = tmp_path / "exit.py"
+    script.write_text(EXIT_SCRIPT)
+    for _ in range(4):
+        t0 = time.monotonic()
+        r = subprocess.run([sys.executable, str(script), str(DOOR)], capture_output=True, text=True, timeout=60)
+        assert r.returncode == 0 and r.stdout.strip() == "exiting", (r.returncode, r.stderr[-2000:])
+        assert "terminate" not in r.stderr
+        assert time.monotonic() - t0 < 20  # the 30 s render was stopped, not waited out

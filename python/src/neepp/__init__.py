@@ -12,6 +12,7 @@ a scene problem is `SceneError` (a ValueError with file, line and problem), a ba
 """
 from __future__ import annotations
 
+import atexit
 import json
 from typing import Callable, Optional, Union
 
@@ -20,6 +21,11 @@ import numpy as np
 from . import metrics
 from . import _neepp
 from ._neepp import Scene, SceneError, VisibilityMap
+
+# A render still running on a daemon thread when the interpreter exits would be killed mid-render at its
+# next GIL acquisition, its worker threads left running into the process's teardown (a crash at exit).
+# Before finalization every render under way is cancelled (its thread gets the image so far) and waited for.
+atexit.register(_neepp._stop_renders, 30.0)
 
 __all__ = ["Scene", "SceneError", "VisibilityMap", "load", "check", "render", "read_image", "read_exr", "write_exr",
            "write_png", "metrics", "option_text"]
