@@ -137,6 +137,14 @@ def test_callback_cancel_and_exception_leave_the_other_render_alone(door, office
     assert np.array_equal(other, alone["neepp"])
 
 
+def test_callback_false_stops_a_range_with_an_error(door):
+    # A range stopped early is not a partial range (its sums would count for nothing): render_range raises.
+    t0 = time.monotonic()
+    with pytest.raises(RuntimeError, match="stopped by the progress callback"):
+        neepp._neepp.render_range(door, "path", {}, 0, 100000, 1, 1, "", b"", lambda f: False)
+    assert time.monotonic() - t0 < 20
+
+
 def test_slow_callback_while_the_render_ends(door, office, alone):
     # The render finishes while its callback is still running (and holds the GIL): the render must wait
     # for it, not deadlock, and the other thread's render is unaffected by that GIL holder.
