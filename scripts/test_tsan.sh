@@ -1,6 +1,9 @@
 #!/usr/bin/env bash
 # ThreadSanitizer over what runs in parallel: the render loop (tiles, the image and splat merges,
-# checkpoints; tests/render), NEE++'s map (per-thread learning merged between passes, seeding;
+# checkpoints; tests/render), renders at once in one process as the Python package's threads make them
+# (two renders, a render while a scene loads, a cancel from the progress listener;
+# tests/render/test_concurrent_renders.cpp: the interpreter is not instrumented, so the Python threads'
+# races are looked for here), NEE++'s map (per-thread learning merged between passes, seeding;
 # tests/visibility) and the display's sending thread (tests/display). TSan must see the thread pool's
 # synchronisation, so oneTBB is first rebuilt with
 # -fsanitize=thread from Debian's own source package (build-tsan/tbb; about 30 s), and neepp's tests are
@@ -47,4 +50,4 @@ for t in test_render test_visibility test_display; do
   fi
   "$B/$t" --gtest_brief=1
 done
-echo "test_tsan: no data race in the render loop's, the visibility map's or the display's tests"
+echo "test_tsan: no data race in the render loop's (concurrent renders included), the visibility map's or the display's tests"

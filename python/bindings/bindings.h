@@ -1,5 +1,6 @@
 // The parts of the neepp._neepp extension module, and what they share.
 #pragma once
+#include <atomic>
 #include <map>
 #include <memory>
 #include <string>
@@ -26,6 +27,23 @@ void bind_checkpoint(nb::module_ &m);
 // the CLI makes it.
 std::unique_ptr<Integrator> scene_integrator(const Scene &scene, const std::string &name,
                                              const std::map<std::string, std::string> &overrides);
+
+// The renders under way in this process, by their cancel flags, so that the interpreter's exit can stop
+// them first (stop_renders, neepp's atexit handler). A render thread left running into the interpreter's
+// finalization is ended there (pthread_exit) when it next takes the GIL, which aborts the process
+// (its unwinding meets nanobind's noexcept GIL guards), and the render's own threads would run on while
+// the process tears down what they use. Held, with the GIL, from before a render starts until its
+// binding returns to Python.
+class RenderInFlight {
+public:
+    explicit RenderInFlight(std::atomic<bool> &cancel);
+    ~RenderInFlight();
+    RenderInFlight(const RenderInFlight &) = delete;
+    RenderInFlight &operator=(const RenderInFlight &) = delete;
+
+private:
+    std::atomic<bool> &cancel_;
+};
 
 // An (H, W, C) float32 numpy array that takes over the image's pixels (no copy).
 nb::ndarray<nb::numpy, float> to_numpy(Image &&image);

@@ -89,6 +89,8 @@ public:
             std::atomic<bool> &flag;
             ~Rendering() { flag = false; }
         } rendering{rendering_};
+        // Stopped by the interpreter's exit (stop_renders), which waits until this is back in Python.
+        const RenderInFlight flight(cancel_);
 
         Camera &cam = scene_.camera;
         const Camera full = cam;

@@ -1,12 +1,15 @@
 // neepp.render: the render loop the CLI runs, on a scene loaded in Python. The render runs on a thread of
 // its own with the GIL released, while the calling thread watches it: it forwards the fraction done to the
-// progress callback and turns Ctrl-C (a pending KeyboardInterrupt) into the render loop's cancel, which
-// ends the render with the image of the passes completed, as the CLI does on SIGINT.
+// progress callback and turns Ctrl-C (a pending KeyboardInterrupt) or the callback's False into the render
+// loop's cancel, which ends the render with the image of the passes completed, as the CLI does on SIGINT.
+// The render thread never touches Python: the GIL is free for other Python threads (their own renders
+// included) the whole time, taken back only to call the callback and to check for signals.
 #include <atomic>
 #include <chrono>
 #include <condition_variable>
 #include <mutex>
 #include <optional>
+#include <set>
 #include <thread>
 #include <nanobind/stl/map.h>
 #include <nanobind/stl/pair.h>
@@ -28,6 +31,47 @@ std::unique_ptr<Integrator> scene_integrator(const Scene &scene, const std::stri
 
 namespace {
 
+struct InFlight {
+    std::mutex mutex;
+    std::condition_variable ended;
+    std::set<std::atomic<bool> *> cancels;
+    bool exiting = false;  // set by stop_renders: a render that starts after it stops at once
+};
+InFlight &in_flight() {
+    static InFlight &f = *new InFlight;  // never destroyed: a daemon thread's render may outlive exit's destructors
+    return f;
+}
+
+// neepp's atexit handler: cancels every render under way and waits (GIL released: they may need it to end)
+// until each has returned, or timeout_s. Python runs it before finalization, while daemon threads still
+// run: their renders end with the image so far and nothing is left running into the teardown.
+bool stop_renders(double timeout_s) {
+    InFlight &f = in_flight();
+    nb::gil_scoped_release release;
+    std::unique_lock<std::mutex> lock(f.mutex);
+    f.exiting = true;
+    for (std::atomic<bool> *c : f.cancels) *c = true;
+    return f.ended.wait_for(lock, std::chrono::duration<double>(timeout_s), [&] { return f.cancels.empty(); });
+}
+
+}  // namespace
+
+RenderInFlight::RenderInFlight(std::atomic<bool> &cancel) : cancel_(cancel) {
+    InFlight &f = in_flight();
+    std::lock_guard<std::mutex> lock(f.mutex);
+    f.cancels.insert(&cancel_);
+    if (f.exiting) cancel_ = true;
+}
+
+RenderInFlight::~RenderInFlight() {
+    InFlight &f = in_flight();
+    std::lock_guard<std::mutex> lock(f.mutex);
+    f.cancels.erase(&cancel_);
+    f.ended.notify_all();
+}
+
+namespace {
+
 RenderJob make_job(const Scene &scene, int spp, double time_s, uint64_t seed, int threads, const std::string &sampler) {
     RenderJob job;
     job.spp = spp > 0 ? spp : (time_s > 0 ? 0 : scene.settings.spp);
@@ -41,6 +85,7 @@ RenderJob make_job(const Scene &scene, int spp, double time_s, uint64_t seed, in
 struct Watched {
     RenderResult result;
     bool interrupted = false;  // by Ctrl-C
+    bool cancelled = false;    // by the progress callback's False
 };
 
 // Renders on a thread of its own while this (the Python) thread forwards progress and watches for Ctrl-C.
@@ -58,6 +103,10 @@ Watched render_watched(const Scene &scene, Integrator &integrator, RenderJob job
     std::condition_variable finished;
     bool done = false;
     std::optional<nb::python_error> raised;  // by the callback or a signal handler: ends the render, raised after it
+    // Until this function is back in Python, GIL held: the interpreter's exit must not begin before, since
+    // a daemon thread that takes the GIL after it has begun is ended by pthread_exit, whose unwinding
+    // cannot pass nanobind's GIL guards (noexcept) and aborts the process.
+    const RenderInFlight flight(cancel);
     {
         nb::gil_scoped_release release;
         std::thread worker([&] {
@@ -85,7 +134,14 @@ Watched render_watched(const Scene &scene, Integrator &integrator, RenderJob job
                     }
                 } else if (callback && !cancel) {
                     try {
-                        progress(fraction.load());
+                        // False (not None, what a callback that returns nothing gives): stop as Ctrl-C
+                        // does, with the image of the passes completed. The one way to stop a render
+                        // running on another Python thread and keep its image, since Ctrl-C reaches the
+                        // main thread only.
+                        if (progress(fraction.load()).is(nb::handle(Py_False))) {
+                            cancel = true;
+                            watched.cancelled = true;
+                        }
                     } catch (nb::python_error &e) {
                         cancel = true;
                         raised.emplace(e);
@@ -135,6 +191,8 @@ nb::dict render_range(const Scene &scene, const std::string &integrator_name,
         PyErr_SetNone(PyExc_KeyboardInterrupt);
         throw nb::python_error();
     }
+    if (w.cancelled && w.result.stopped_by == "cancel")
+        throw std::runtime_error("render_range: stopped by the progress callback before the range was complete");
     RenderCheckpoint &c = w.result.state;
     nb::dict out;
     out["first"] = first;
@@ -150,6 +208,9 @@ nb::dict render_range(const Scene &scene, const std::string &integrator_name,
 }  // namespace
 
 void bind_render(nb::module_ &m) {
+    m.def("_stop_renders", &stop_renders, nb::arg("timeout"),
+          "Cancels every render under way and waits up to timeout seconds for them to return (True: all did). "
+          "neepp's atexit handler.");
     using Doubles = nb::ndarray<const double, nb::ndim<1>, nb::c_contig, nb::device::cpu>;
     using Int64s = nb::ndarray<const int64_t, nb::ndim<1>, nb::c_contig, nb::device::cpu>;
     m.def("render_range", &render_range, nb::arg("scene"), nb::arg("integrator"), nb::arg("options"), nb::arg("first"),

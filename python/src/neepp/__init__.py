@@ -12,6 +12,7 @@ a scene problem is `SceneError` (a ValueError with file, line and problem), a ba
 """
 from __future__ import annotations
 
+import atexit
 import json
 from typing import Callable, Optional, Union
 
@@ -20,6 +21,11 @@ import numpy as np
 from . import metrics
 from . import _neepp
 from ._neepp import Scene, SceneError, VisibilityMap
+
+# A render still running on a daemon thread when the interpreter exits would be killed mid-render at its
+# next GIL acquisition, its worker threads left running into the process's teardown (a crash at exit).
+# Before finalization every render under way is cancelled (its thread gets the image so far) and waited for.
+atexit.register(_neepp._stop_renders, 30.0)
 
 __all__ = ["Scene", "SceneError", "VisibilityMap", "load", "check", "render", "read_image", "read_exr", "write_exr",
            "write_png", "metrics", "option_text"]
@@ -59,7 +65,11 @@ def render(scene: Scene, spp: Optional[int] = None, time: Optional[float] = None
     seed: the sampler's seed (default: the scene's). threads: worker threads (default: all cores).
     progress: a callable given the fraction done (0..1) a few times a second, or True for the CLI's bar.
     Ctrl-C stops the render and returns the image of the passes completed (stats["stopped_by"] is
-    "cancel"), as the CLI does; an exception raised by the callback stops it and propagates.
+    "cancel"), as the CLI does, and so does the callback returning False (None goes on); an exception
+    raised by the callback stops it and propagates. The callback runs on the calling thread.
+
+    Renders may run on several Python threads at once (the GIL is released while one works), each on
+    its own `threads`, and give the images they give alone (README: "Threads").
     """
     if spp is not None and time is not None:
         raise ValueError("give spp or time, not both")

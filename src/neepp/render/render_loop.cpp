@@ -6,6 +6,7 @@
 #include <limits>
 #include <memory>
 #include <mutex>
+#include <set>
 #include <tbb/enumerable_thread_specific.h>
 #include <tbb/global_control.h>
 #include <tbb/parallel_for.h>
@@ -125,6 +126,55 @@ private:
     const double time_before_;
 };
 
+// TBB's worker threads are one pool for the whole process, and a tbb::global_control sizes that pool for
+// the whole process, the smallest of all those alive winning. A render that held one at its own thread
+// count (as this loop once did) cut every render running beside it (another Python thread's, a view's)
+// down to that count, and a render with threads=1 stopped the others' workers altogether. So a render's
+// thread count is the size of its task_arena alone, everything the render does running in that arena
+// (render()), and the pool is only ever raised: to the largest count that a running render asks for
+// beyond the cores (--threads 32 on 16 cores), so that such an arena can fill; back to TBB's default when
+// the last of them ends.
+class WorkerPoolLease {
+public:
+    explicit WorkerPoolLease(size_t threads) : threads_(threads) {
+        Pool &p = pool();
+        std::lock_guard<std::mutex> lock(p.mutex);
+        p.asked.insert(threads_);
+        p.resize();
+    }
+    ~WorkerPoolLease() {
+        Pool &p = pool();
+        std::lock_guard<std::mutex> lock(p.mutex);
+        p.asked.erase(p.asked.find(threads_));
+        p.resize();
+    }
+    WorkerPoolLease(const WorkerPoolLease &) = delete;
+    WorkerPoolLease &operator=(const WorkerPoolLease &) = delete;
+
+private:
+    struct Pool {
+        std::mutex mutex;
+        std::multiset<size_t> asked;  // the thread counts of the renders running
+        size_t raised_to = 0;         // 0: not raised (TBB's default, the cores)
+        std::unique_ptr<tbb::global_control> control;
+        void resize() {
+            const size_t cores = size_t(tbb::info::default_concurrency());
+            const size_t want = asked.empty() || *asked.rbegin() <= cores ? 0 : *asked.rbegin();
+            if (want == raised_to) return;
+            // The new limit exists before the old goes: the pool never drops to the default in between.
+            std::unique_ptr<tbb::global_control> next;
+            if (want > 0) next = std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism, want);
+            control = std::move(next);
+            raised_to = want;
+        }
+    };
+    static Pool &pool() {
+        static Pool p;
+        return p;
+    }
+    const size_t threads_;
+};
+
 // One call of render(): the image so far, its passes, and what the render loop reports and saves.
 class RenderLoop {
 public:
@@ -139,9 +189,16 @@ public:
     }
 
     RenderLoop(const Scene &scene, Integrator &integrator, const RenderJob &job);
-    RenderResult run();
+    // The whole render in its own arena: the integrator's preparation and between-pass work (NEE++'s
+    // map seeding, its merges) with their parallel loops included, which would otherwise run in the
+    // calling thread's default arena on every core, not the threads the job asks for.
+    RenderResult run() {
+        return arena_.execute([this] { return run_in_arena(); });
+    }
 
 private:
+    RenderResult run_in_arena();
+
     bool cancelled() const { return job_.cancel && job_.cancel->load(); }
     // One pass of `size` samples per pixel into pass_block_ (and splats_pass_); false when it was cut short.
     bool render_pass(int size);
@@ -197,7 +254,7 @@ private:
     std::vector<double> tile_m2_;  // Σ lum(L)² per tile this pass, summed in tile order
     const std::unique_ptr<Sampler> prototype_;
     const int threads_;
-    tbb::global_control limit_;
+    const WorkerPoolLease pool_;
     tbb::task_arena arena_;
     tbb::enumerable_thread_specific<RenderCounters> counters_;
     RenderCounters counters_before_;        // a resumed render's
@@ -224,7 +281,7 @@ RenderLoop::RenderLoop(const Scene &scene, Integrator &integrator, const RenderJ
       tiles_(make_tiles(W_, H_, job.tile_size)), tile_m2_(tiles_.size()),
       prototype_(make_sampler(job.sampler, job.seed)),
       threads_(job.threads > 0 ? job.threads : tbb::info::default_concurrency()),
-      limit_(tbb::global_control::max_allowed_parallelism, size_t(threads_)), arena_(threads_), budget_(job),
+      pool_(size_t(threads_)), arena_(threads_), budget_(job),
       cpu_start_(cpu_seconds(CpuClock::process)) {
     border_ = int(std::ceil(filter_.radius() - 0.5f));
     if (splatting_) {
@@ -233,7 +290,7 @@ RenderLoop::RenderLoop(const Scene &scene, Integrator &integrator, const RenderJ
     }
 }
 
-RenderResult RenderLoop::run() {
+RenderResult RenderLoop::run_in_arena() {
     ProgressBar bar([this] { return budget_.fraction(spp_done_now_.load() + double(samples_done_.load()) / (double(W_) * H_)); },
                     job_.progress, job_.on_progress);
     if (!job_.prepared) integrator_.prepare(scene_);
