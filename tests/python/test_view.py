@@ -133,6 +133,48 @@ def test_live_render_keeps_its_integrator_across_camera_moves():
     assert scene.camera["fov"] == pytest.approx(cam.fov)  # a refused camera leaves the one in force
 
 
+def test_live_render_map_view_reads_the_map(tmp_path):
+    """The map view's parts: a pixel's first hit and its cell, the map's row of that cell (Ṽ to every cell,
+    NaN where unknown) equal to the map's counts as its file holds them, and the light distribution there."""
+    scene = neepp.load(DEMO, resx=32, resy=18)
+    live = neepp._neepp.LiveRender(scene, "path", {"shadow_rays": "neepp"}, 2, "", 0)
+    assert live.map_info() is None  # no map before the first render prepares it
+    live.render(4)
+    info = live.map_info()
+    assert info["resolution"] == 16 and info["known_pairs"] > 0
+    cells = live.pixel_cells()
+    assert cells.shape == (18, 32) and cells.dtype == np.int32
+    assert np.all((cells >= -1) & (cells < info["voxel_count"])) and np.count_nonzero(cells >= 0) > 0.9 * cells.size
+    # A pixel whose cell the map knows pairs of (NEE++ learns pairs of a shading cell and a light cell).
+    y, x = next((y, x) for y, x in np.argwhere(cells >= 0) if np.isfinite(live.visibility_row(cells[y, x])).any())
+    hit = live.pick(int(x), int(y))
+    assert hit["cell"] == cells[y, x] and len(hit["point"]) == 3
+    assert hit["light_pmf"].shape == (len(scene.lights),) and hit["light_pmf"].sum() == pytest.approx(1.0)
+    row = live.visibility_row(hit["cell"])
+    assert row.shape == (info["cell_count"],)
+    # The row against the map itself, read back from the file it saves (the project's map format).
+    assert live.save_visibility_map(tmp_path / "map.vis")
+    saved = neepp.VisibilityMap.load(tmp_path / "map.vis", scene, 16)
+    counts = saved.counts()
+    pairs = np.array([saved.pair_index(hit["cell"], b) for b in range(info["cell_count"])])
+    visible, traced = counts[pairs, 0].astype(np.float64), counts[pairs, 1].astype(np.float64)
+    expect = np.where(traced > 0, (visible + 1) / (traced + 2), np.nan)
+    assert np.array_equal(np.isnan(row), np.isnan(expect))
+    assert np.allclose(row[traced > 0], expect[traced > 0], rtol=1e-6)
+    assert np.count_nonzero(traced > 0) > 0
+    with pytest.raises(IndexError):
+        live.visibility_row(info["cell_count"])
+    with pytest.raises(ValueError, match="outside"):
+        live.pick(32, 0)
+    # No map where the integrator keeps none (plain NEE, the bvh light sampler); a pick still answers.
+    plain = neepp._neepp.LiveRender(neepp.load(DEMO, resx=32, resy=18), "path", {}, 2, "", 0)
+    plain.render(1)
+    assert plain.map_info() is None and plain.pick(13, 11)["cell"] == -1
+    assert not plain.save_visibility_map(tmp_path / "none.vis") and not (tmp_path / "none.vis").exists()
+    with pytest.raises(RuntimeError, match="no visibility map"):
+        plain.pixel_cells()
+
+
 def test_live_render_cancel_stops_at_once():
     scene = neepp.load(DEMO, resx=64, resy=36)
     live = neepp._neepp.LiveRender(scene, "path", {}, 2, "", 0)
@@ -293,6 +335,40 @@ def test_save_writes_exr_png_and_statistics(viewer):
     assert record["scene"].endswith("scene.xml") and "shadow_rays" in record and "integrator" in record
 
 
+def test_a_click_shows_the_map_view(viewer):
+    """A pick (the page's click) is answered with the heat map of Ṽ from the clicked point's cell over the
+    image, and the light distribution there; the image goes on converging (a pick does not restart it)."""
+    async def body(page):
+        await page.send({"type": "options", "integrator": "path", "options": {"shadow_rays": "neepp"}})
+        before = await page.until(lambda m: full_frame()(m) and m["options"].get("shadow_rays") == "neepp", "a frame")
+        await page.send({"type": "pick", "x": W * 2 // 5, "y": H * 3 // 5})
+        while True:
+            msg = await page.ws.receive(timeout=TIMEOUT)
+            if msg.type == aiohttp.WSMsgType.BINARY:
+                header, data = messages.decode_frame(msg.data)
+                if header.get("kind") == "map":
+                    break
+            assert msg.type in (aiohttp.WSMsgType.BINARY, aiohttp.WSMsgType.TEXT), msg
+        after = await page.until(lambda m: full_frame(before["view"])(m) and m["spp"] > before["spp"], "more samples")
+        await page.send({"type": "pick", "x": W, "y": 0})
+        error = await page.until(lambda m: m["type"] == "error", "the refusal of a pixel outside")
+        await page.send({"type": "options", "integrator": "path", "options": {}})
+        await page.until(lambda m: m["type"] == "state" and not m["options"], "the scene's options")
+        return before, header, data, after, error
+
+    before, header, data, after, error = run(with_page(viewer["url"], body))
+    assert header["hit"] and header["cell"] >= 0 and header["map"]["resolution"] == 16
+    assert (header["width"], header["height"], header["channels"]) == (W, H, 1)
+    heat = np.frombuffer(data, dtype="<f4").reshape(H, W)
+    known = heat[np.isfinite(heat)]
+    assert known.size > 0.5 * heat.size and np.all((known > 0) & (known < 1))
+    assert known.max() - known.min() > 0.3, (known.min(), known.max())
+    assert header["known_fraction"] == pytest.approx(known.size / heat.size)
+    assert [light["pmf"] for light in header["lights"]] == [1.0] and header["light_count"] == 1
+    assert after["view"] == before["view"]  # the image was not restarted
+    assert "outside" in error["message"]
+
+
 @pytest.mark.parametrize("bad, expect", [
     ("not json", "not JSON"),
     ("[1, 2]", "JSON object"),
@@ -306,6 +382,8 @@ def test_save_writes_exr_png_and_statistics(viewer):
     ('{"type": "options", "integrator": "", "options": {}}', "'integrator'"),
     ('{"type": "options", "integrator": "no-such", "options": {}}', "no-such"),
     ("[" * 5000 + "]" * 5000, "not JSON"),  # deeper than the parser goes
+    ('{"type": "pick", "x": 1.5, "y": 0}', "pixel index"),
+    ('{"type": "pick", "x": -1, "y": 0}', "pixel index"),
     (b"\x00\x01binary", "JSON text"),
 ])
 def test_malformed_messages_are_refused(viewer, bad, expect):
@@ -416,8 +494,8 @@ async def run_in_chromium(url, profile: Path, timeout=90.0):
 
 def test_page_in_headless_chromium(viewer, tmp_path):
     """The page's own self-test (#selftest) in a real browser: frames converge, a mouse drag restarts the
-    view, switching the shadow-ray policy to neepp-adaptive shows shadow rays skipped; no console error,
-    and nothing requested from anywhere but the server."""
+    view, switching the shadow-ray policy to neepp-adaptive shows shadow rays skipped, a click shows the
+    map's heat map over the image; no console error, and nothing requested from anywhere but the server."""
     verdict, problems, urls = run(run_in_chromium(viewer["url"] + "#selftest", tmp_path / "profile"))
     assert verdict and verdict.startswith("selftest ok"), (verdict, problems)
     assert not problems, problems
