@@ -316,14 +316,30 @@ def test_an_option_change_changes_the_statistics(viewer):
     assert kept["options"] == {"shadow_rays": "neepp-adaptive"}
 
 
-def test_save_writes_exr_png_and_statistics(viewer):
+def test_save_writes_exr_png_statistics_and_the_map(viewer):
     async def body(page):
         await page.until(full_frame(), "a full frame")
         await page.send({"type": "save", "exposure": 1.0})
-        return await page.until(lambda m: m["type"] in ("saved", "error"), "the save")
+        plain = await page.until(lambda m: m["type"] in ("saved", "error"), "the save")
+        # With NEE++ the map is saved too, in the project's map format.
+        await page.send({"type": "options", "integrator": "path", "options": {"shadow_rays": "neepp"}})
+        await page.until(lambda m: full_frame()(m) and m["options"].get("shadow_rays") == "neepp", "a NEE++ frame")
+        await page.send({"type": "save"})
+        with_map = await page.until(lambda m: m["type"] in ("saved", "error"), "the save with the map")
+        await page.send({"type": "options", "integrator": "path", "options": {}})
+        await page.until(lambda m: m["type"] == "state" and not m["options"], "the scene's options")
+        return plain, with_map
 
-    saved = run(with_page(viewer["url"], body))
+    saved, with_map = run(with_page(viewer["url"], body))
     assert saved["type"] == "saved", saved
+    assert with_map["type"] == "saved", with_map
+    assert [Path(f).suffix for f in with_map["files"]] == [".exr", ".png", ".json", ".vis"]
+    record = json.loads(Path(with_map["files"][2]).read_text())
+    assert record["visibility_map"]["file"] == Path(with_map["files"][3]).name
+    scene = neepp.load(DEMO, resx=W, resy=H)
+    loaded = neepp.VisibilityMap.load(with_map["files"][3], scene, record["visibility_map"]["resolution"])
+    assert loaded.known_pairs == record["visibility_map"]["known_pairs"] > 0
+    assert record["shadow_rays"] > 0 and neepp.read_exr(with_map["files"][0]).shape[:2] == (H, W)
     exr, png, stats = (Path(f) for f in saved["files"])
     assert exr.suffix == ".exr" and png.suffix == ".png" and stats.suffix == ".json"
     assert exr.parent == viewer["out"]
@@ -333,6 +349,7 @@ def test_save_writes_exr_png_and_statistics(viewer):
     record = json.loads(stats.read_text())
     assert record["spp"] >= 1 and record["exposure"] == 1.0 and len(record["to_world"]) == 4
     assert record["scene"].endswith("scene.xml") and "shadow_rays" in record and "integrator" in record
+    assert "visibility_map" not in record  # plain NEE keeps no map
 
 
 def test_a_click_shows_the_map_view(viewer):

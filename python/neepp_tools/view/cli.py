@@ -45,7 +45,7 @@ def parse_args(argv):
     p.add_argument("--threads", type=int, default=0, help="Worker threads (default: all cores)")
     p.add_argument("--seed", type=int, default=None, help="Random seed (default: the scene's)")
     p.add_argument("-o", "--output-dir", type=Path, default=Path("neepp-view"),
-                   help="Where the save button writes view_NNN.exr, .png and .json (default neepp-view)")
+                   help="Where the save button writes view_NNN.exr, .png, .json and .vis (NEE++'s map) (default neepp-view)")
     a = p.parse_args(argv)
     if not 0 <= a.port <= 65535:
         p.error(f"--port {a.port}: not a port (0..65535)")
