@@ -50,8 +50,12 @@ def start_view(neepp_bin, out_dir, *extra):
 @pytest.fixture(scope="module")
 def viewer(neepp_bin, tmp_path_factory):
     out = tmp_path_factory.mktemp("view")
-    proc, url, port = start_view(neepp_bin, out / "saved")
-    yield {"proc": proc, "url": url, "port": port, "out": out / "saved"}
+    # A reference of the film's size (not the scene's image: the relMSE need only be measured against it).
+    reference = np.full((H, W, 3), 0.05, np.float32)
+    reference[:, : W // 2] = 0.2
+    neepp.write_exr(out / "reference.exr", reference)
+    proc, url, port = start_view(neepp_bin, out / "saved", "--reference", str(out / "reference.exr"))
+    yield {"proc": proc, "url": url, "port": port, "out": out / "saved", "reference": reference}
     proc.send_signal(signal.SIGTERM)
     proc.wait(timeout=20)
 
@@ -64,9 +68,13 @@ class Page:
         self.state = None
 
     async def next(self, timeout=TIMEOUT):
-        msg = await self.ws.receive(timeout=timeout)
+        return await self._decode(await self.ws.receive(timeout=timeout))
+
+    async def _decode(self, msg):
         if msg.type == aiohttp.WSMsgType.BINARY:
             header, pixels = messages.decode_frame(msg.data)
+            if header.get("kind"):  # a map view or the reference, not a frame
+                return {"type": "binary", "header": header, "pixels": pixels}
             image = np.frombuffer(pixels, dtype="<f4").reshape(header["height"], header["width"], 3)
             return {"type": "frame", **header, "image": image}
         if msg.type == aiohttp.WSMsgType.TEXT:
@@ -359,13 +367,8 @@ def test_a_click_shows_the_map_view(viewer):
         await page.send({"type": "options", "integrator": "path", "options": {"shadow_rays": "neepp"}})
         before = await page.until(lambda m: full_frame()(m) and m["options"].get("shadow_rays") == "neepp", "a frame")
         await page.send({"type": "pick", "x": W * 2 // 5, "y": H * 3 // 5})
-        while True:
-            msg = await page.ws.receive(timeout=TIMEOUT)
-            if msg.type == aiohttp.WSMsgType.BINARY:
-                header, data = messages.decode_frame(msg.data)
-                if header.get("kind") == "map":
-                    break
-            assert msg.type in (aiohttp.WSMsgType.BINARY, aiohttp.WSMsgType.TEXT), msg
+        mapped = await page.until(lambda m: m["type"] == "binary" and m["header"]["kind"] == "map", "the map view")
+        header, data = mapped["header"], mapped["pixels"]
         after = await page.until(lambda m: full_frame(before["view"])(m) and m["spp"] > before["spp"], "more samples")
         await page.send({"type": "pick", "x": W, "y": 0})
         error = await page.until(lambda m: m["type"] == "error", "the refusal of a pixel outside")
@@ -386,6 +389,44 @@ def test_a_click_shows_the_map_view(viewer):
     assert "outside" in error["message"]
 
 
+def test_the_relmse_against_a_reference_or_a_saved_image(viewer):
+    from neepp_tools.metrics import relmse
+
+    def binary(kind):
+        def test(m):
+            return m["type"] == "binary" and m["header"].get("kind") == kind
+        return test
+
+    async def body(page):
+        first = await page.until(binary("reference"), "the reference, sent on connecting")
+        framed = await page.until(lambda m: full_frame()(m) and "relmse" in m, "a frame with its relMSE")
+        await page.send({"type": "reference", "source": "none"})
+        await page.until(binary("reference"), "no reference")
+        await page.until(lambda m: m["type"] == "state" and m["reference"] is None, "the state without one")
+        bare = await page.until(full_frame(), "a frame")
+        bare = await page.until(full_frame(), "a frame measured against nothing")
+        await page.send({"type": "save"})
+        saved = await page.until(lambda m: m["type"] in ("saved", "error"), "the save")
+        await page.send({"type": "reference", "source": "saved"})
+        stored = await page.until(binary("reference"), "the saved image as the reference")
+        against = await page.until(lambda m: full_frame()(m) and "relmse" in m, "a frame against it")
+        return first, framed, bare, saved, stored, against
+
+    first, framed, bare, saved, stored, against = run(with_page(viewer["url"], body))
+    ref = np.frombuffer(first["pixels"], dtype="<f4").reshape(H, W, 3)
+    assert np.array_equal(ref, viewer["reference"]) and first["header"]["name"].endswith("reference.exr")
+    assert framed["relmse"] == pytest.approx(relmse(framed["image"], viewer["reference"]), rel=1e-9)
+    assert framed["relmse"] > 0.1 and framed["reference"].endswith("reference.exr")
+    assert "relmse" not in bare
+    assert saved["type"] == "saved", saved
+    image = neepp.read_exr(saved["files"][0])[..., :3]
+    stored_image = np.frombuffer(stored["pixels"], dtype="<f4").reshape(H, W, 3)
+    assert np.array_equal(stored_image, image) and "as saved" in stored["header"]["name"]
+    # Against the image it converges to: small, and the same number as neepp compare's metric gives.
+    assert against["relmse"] == pytest.approx(relmse(against["image"], image), rel=1e-9)
+    assert against["relmse"] < framed["relmse"]
+
+
 @pytest.mark.parametrize("bad, expect", [
     ("not json", "not JSON"),
     ("[1, 2]", "JSON object"),
@@ -401,6 +442,7 @@ def test_a_click_shows_the_map_view(viewer):
     ("[" * 5000 + "]" * 5000, "not JSON"),  # deeper than the parser goes
     ('{"type": "pick", "x": 1.5, "y": 0}', "pixel index"),
     ('{"type": "pick", "x": -1, "y": 0}', "pixel index"),
+    ('{"type": "reference", "source": "/etc/passwd"}', "'source'"),
     (b"\x00\x01binary", "JSON text"),
 ])
 def test_malformed_messages_are_refused(viewer, bad, expect):
@@ -547,6 +589,13 @@ def test_a_port_in_use_is_a_clear_error(neepp_bin, tmp_path):
         r = subprocess.run([str(neepp_bin), "view", str(DEMO), "-D", f"resx={W}", "-D", f"resy={H}", "--port", str(port)],
                            capture_output=True, text=True, timeout=60)
     assert r.returncode == 1 and f"127.0.0.1:{port}" in r.stderr and "Traceback" not in r.stderr, r.stderr
+
+
+def test_a_reference_of_another_size_is_a_clear_error(neepp_bin, tmp_path):
+    neepp.write_exr(tmp_path / "small.exr", np.zeros((4, 4, 3), np.float32))
+    r = subprocess.run([str(neepp_bin), "view", str(DEMO), "-D", f"resx={W}", "-D", f"resy={H}", "--reference",
+                        str(tmp_path / "small.exr")], capture_output=True, text=True, timeout=60)
+    assert r.returncode == 1 and "4x4" in r.stderr and f"{W}x{H}" in r.stderr and "Traceback" not in r.stderr, r.stderr
 
 
 def test_without_its_python_modules_it_says_what_is_missing(neepp_bin, tmp_path):

@@ -116,6 +116,8 @@ class ViewServer:
         self.clients.add(client)
         pump = asyncio.create_task(client.pump())
         client.send_text(self.session.state())
+        if self.session.reference is not None:
+            client.send_binary(messages.encode_reference(self.session.reference_name, self.session.reference))
         latest = self.session.latest
         if latest is not None:
             client.send_frame(messages.encode_frame(latest.stats, latest.image.astype("<f4", copy=False).tobytes()))
@@ -152,6 +154,19 @@ class ViewServer:
                 client.send_text({"type": "error", "message": f"map view: {e}"})
             else:
                 client.send_binary(messages.encode_map(result, heat))
+        elif kind == "reference":
+            try:
+                if command["source"] == "saved":
+                    self.session.reference_from_saved()
+                else:
+                    self.session.set_reference(None, "")
+            except ValueError as e:
+                client.send_text({"type": "error", "message": f"reference: {e}"})
+                return
+            data = messages.encode_reference(self.session.reference_name, self.session.reference)
+            for c in list(self.clients):  # every page shows the same view, and measures it the same way
+                c.send_binary(data)
+                c.send_text(self.session.state())
         elif kind == "save":
             try:
                 files = await asyncio.get_running_loop().run_in_executor(None, self.session.save, command["exposure"])

@@ -26,6 +26,7 @@ import numpy as np
 import neepp
 from neepp import _neepp
 
+from ..metrics import relmse
 from .orbit import OrbitCamera
 
 PREVIEW_SCALE = 4
@@ -62,6 +63,10 @@ class ViewSession:
         self._requests: list = []  # (function, future): questions for the render thread
         self._cells: Optional[tuple] = None  # (camera, pixel_cells()) of the last map view
         self._seen_count = 0
+        # The image the relMSE is measured against ((H, W, 3) float32) and what it is; None: no reference.
+        self.reference: Optional[np.ndarray] = None
+        self.reference_name = ""
+        self.last_saved: Optional[Frame] = None
         self._stopping = False
         self.latest: Optional[Frame] = None  # the newest full-resolution image, for save
         self.view_in_render, self.camera_in_render = -1, {"to_world": self.camera.to_world(), "fov": self.camera.fov}
@@ -95,7 +100,7 @@ class ViewSession:
         return {"type": "state", "scene": self.scene.path, "width": self.scene.width, "height": self.scene.height,
                 "integrator": self.integrator, "options": self.options(),
                 "scene_options": self.scene.integrator_options, "fov": self.camera.fov,
-                "max_spp": self.max_spp, "catalog": _neepp.catalog()}
+                "max_spp": self.max_spp, "catalog": _neepp.catalog(), "reference": self.reference_name or None}
 
     # Changes, from the server's thread: each restarts the render.
     def camera_command(self, command: dict) -> None:
@@ -108,6 +113,27 @@ class ViewSession:
         def apply():
             self._pending_options = (integrator, dict(options))
         self._change(apply)
+
+    def set_reference(self, image: Optional[np.ndarray], name: str) -> None:
+        """The image the relMSE is measured against (the scene's film size, RGB or RGBA), or None. Only
+        camera moves and options make another image: the relMSE means something for the view the reference
+        was made of (the scene's camera, or the saved image's)."""
+        if image is None:
+            self.reference, self.reference_name = None, ""
+            return
+        image = np.asarray(image, dtype=np.float32)
+        if image.ndim != 3 or image.shape[2] < 3 or image.shape[:2] != (self.scene.height, self.scene.width):
+            raise ValueError(f"the reference {name} is {'x'.join(map(str, image.shape[1::-1]))}, the image "
+                             f"{self.scene.width}x{self.scene.height}")
+        if not np.all(np.isfinite(image[..., :3])):
+            raise ValueError(f"the reference {name} has pixels that are not finite")
+        self.reference, self.reference_name = np.ascontiguousarray(image[..., :3]), name
+
+    def reference_from_saved(self) -> None:
+        """The last image saved becomes the reference (a difference against a stored image)."""
+        if self.last_saved is None:
+            raise ValueError("no image saved yet")
+        self.set_reference(self.last_saved.image, f"view {self.last_saved.view} as saved")
 
     def map_view(self, x: int, y: int) -> concurrent.futures.Future:
         """The map seen from pixel (x, y) of the full image, as a future (answered by the render thread
@@ -254,6 +280,11 @@ class ViewSession:
         t = info["render_time_s"]
         stats = {**info, "view": view, "coarse": coarse, "integrator": self.integrator, "options": self.options(),
                  "samples_per_s": info["spp"] * info["width"] * info["height"] / t if t > 0 else 0.0, **camera}
+        reference = self.reference
+        if not coarse and reference is not None and reference.shape == image.shape:
+            # neepp compare's relMSE (metrics.relmse: squared error over reference² + 0.01, averaged).
+            stats["relmse"] = relmse(image, reference)
+            stats["reference"] = self.reference_name
         frame = Frame(view, image, stats)
         if not coarse:
             self.latest = frame

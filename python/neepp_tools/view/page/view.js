@@ -10,6 +10,7 @@ let ws = null;
 let state = null;           // the server's latest "state" message
 let frame = null;           // {header, pixels: Float32Array} of the newest frame
 let mapView = null;         // {header, pixels: Float32Array} of the last map view (a clicked point)
+let reference = null;       // {header, pixels: Float32Array}: the image the relMSE is measured against
 let overlay = null;         // what draw() last laid over the image: {view, known, min, max}
 const listeners = [];       // the self-test's waits: functions called with each frame
 const mapListeners = [];    // ... and with each map view
@@ -49,6 +50,7 @@ function draw() {
   }
   overlay = null;
   if ($("mode").value === "map") drawMap(img.data, width, height);
+  else if ($("mode").value === "relmse") drawRelmse(img.data, width, height);
   ctx.putImageData(img, 0, 0);
 }
 
@@ -98,6 +100,37 @@ function drawMap(dst, width, height) {
     }
   }
   overlay = { view: h.view, known, min, max };
+}
+
+// The per-pixel relMSE against the reference, as neepp compare's relMSE map defines it (squared error over
+// reference² + 0.01, averaged over the channels), on a log scale from 1e-4 (dark) to 1 (bright); the mean
+// of these is the relMSE the statistics show.
+const RELMSE_EPS = 0.01;
+function drawRelmse(dst, width, height) {
+  if (!reference || reference.header.width !== width || reference.header.height !== height) return;
+  const a = frame.pixels, r = reference.pixels;
+  let sum = 0;
+  for (let i = 0, j = 0; i < a.length; i += 3, j += 4) {
+    let e = 0;
+    for (let c = 0; c < 3; c++) {
+      const d = a[i + c] - r[i + c];
+      e += d * d / (r[i + c] * r[i + c] + RELMSE_EPS);
+    }
+    e /= 3;
+    sum += e;
+    const col = heatColor((Math.log10(Math.max(e, 1e-4)) + 4) / 4);
+    dst[j] = col[0];
+    dst[j + 1] = col[1];
+    dst[j + 2] = col[2];
+  }
+  overlay = { view: frame.header.view, relmse: sum / (width * height) };
+}
+
+function showReference(m) {
+  reference = m.header.width ? m : null;
+  $("reference").textContent = reference ? "reference: " + m.header.name
+    : "no reference (neepp view --reference FILE, or a saved image)";
+  draw();
 }
 
 function showMap(m) {
@@ -167,6 +200,7 @@ function showStats(h) {
     shadow_rays_skipped: formatCount(h.shadow_rays_skipped) + percent(h.shadow_rays_skipped, tested),
     shadow_rays_occluded: formatCount(h.shadow_rays_occluded) + percent(h.shadow_rays_occluded, h.shadow_rays),
     fov: h.fov.toFixed(1) + "°",
+    relmse: h.relmse === undefined ? "–" : h.relmse.toExponential(3),
   };
   for (const td of document.querySelectorAll("#stats td")) {
     const key = td.dataset.key;
@@ -237,6 +271,7 @@ function connect() {
     if (event.data instanceof ArrayBuffer) {
       const decoded = decodeFrame(event.data);
       if (decoded.header.kind === "map") { showMap(decoded); return; }
+      if (decoded.header.kind === "reference") { showReference(decoded); return; }
       frame = decoded;
       draw();
       showStats(frame.header);
@@ -349,6 +384,8 @@ $("exposure").addEventListener("input", () => {
 });
 $("save").addEventListener("click", save);
 $("mode").addEventListener("change", draw);
+$("reference-saved").addEventListener("click", () => send({ type: "reference", source: "saved" }));
+$("reference-none").addEventListener("click", () => send({ type: "reference", source: "none" }));
 for (const id of ["integrator", "shadow_rays", "light_sampler"]) $(id).addEventListener("change", sendOptions);
 
 // ---- self-test (#selftest): what the tests check in a real browser ---------------------------------------
@@ -421,6 +458,17 @@ async function selftest() {
       throw new Error("no heat map over the image: " + JSON.stringify(overlay));
     if (!$("map-summary").textContent.includes("known for")) throw new Error("the map panel says nothing");
     log.push(`map from cell ${m.cell}: ${overlay.known} pixels, V~ ${overlay.min.toFixed(3)}..${overlay.max.toFixed(3)}, ${m.lights.length} light(s)`);
+    // The relMSE view (the server was started with a reference): the map drawn here averages to the relMSE
+    // the server measured for the frame.
+    $("mode").value = "relmse";
+    $("mode").dispatchEvent(new Event("change"));
+    const f = await waitFrame((h) => !h.coarse && h.relmse !== undefined, "a frame with its relMSE", 15000);
+    draw();
+    if (!overlay || !(Math.abs(overlay.relmse - f.relmse) <= 1e-3 * f.relmse))
+      throw new Error(`the relMSE map averages to ${overlay && overlay.relmse}, the server says ${f.relmse}`);
+    if (document.querySelector('#stats td[data-key="relmse"]').textContent === "–")
+      throw new Error("the statistics do not show the relMSE");
+    log.push(`relMSE ${f.relmse.toExponential(3)} at ${f.spp} spp`);
     out.textContent = "selftest ok: " + log.join("; ");
   } catch (err) {
     out.textContent = "selftest FAILED: " + err.message + " (" + log.join("; ") + ")";
