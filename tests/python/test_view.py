@@ -183,6 +183,52 @@ def test_live_render_map_view_reads_the_map(tmp_path):
         plain.pixel_cells()
 
 
+def test_live_render_a_kept_map_makes_a_new_views_first_frames_cheaper():
+    """The map kept across a camera move, against a fresh NEE++ render of the new view, over the first 4
+    samples per pixel, at 6 seeds each (independent renders; the per-pixel variance across them). Equal
+    samples cost the two different amounts: a fresh render seeds its map (camera paths and shadow rays) and
+    traces every shadow ray of its first pass (the probe), while the kept map skips rays from the first
+    pass. Their cost is counted in rays traced (camera paths, shadow rays, seeding), not in seconds, so the
+    test does not depend on the machine's load. Per sample the two are about equally noisy (the fresh
+    render's probe pass traces every shadow ray; the kept map skips some of them), per ray traced the kept
+    map is far ahead, which is what a person moving the camera sees: the first frames of the new view
+    arrive sooner. Deterministic: fixed seeds, and the renderer gives the same image on any thread count."""
+    def render(live, spp):
+        images = []
+        stats = json.loads(live.render(spp, on_frame=lambda image, info: images.append(image) if info["final"] else None))
+        return images[-1], stats
+
+    kept, fresh, kept_rays, fresh_rays = [], [], 0, 0
+    for seed in range(6):
+        scene = neepp.load(DEMO, resx=48, resy=27)
+        cam = OrbitCamera(scene.camera["to_world"], scene.camera["fov"], scene.bounds)
+        cam.orbit(0.15, 0.03)
+        live = neepp._neepp.LiveRender(scene, "path", {"shadow_rays": "neepp"}, 2, "", 100 + seed)
+        live.render(32)  # the first view: the map learns
+        live.set_camera(cam.to_world(), cam.fov)
+        image, stats = render(live, 4)
+        # The map carried over (it went on merging what the first view learned) and was not seeded again.
+        assert stats["integrator_statistics"]["shadow_rays"]["roulette"]["passes_merged"] > stats["passes"]
+        kept.append(image)
+        kept_rays += stats["rays"] + stats["shadow_rays"]
+        other = neepp._neepp.LiveRender(neepp.load(DEMO, resx=48, resy=27), "path", {"shadow_rays": "neepp"}, 2, "",
+                                        200 + seed)
+        other.set_camera(cam.to_world(), cam.fov)
+        image, stats = render(other, 4)
+        fresh.append(image)
+        built = stats["integrator_statistics"]["shadow_rays"]["map"]
+        fresh_rays += stats["rays"] + stats["shadow_rays"] + built["build_camera_rays"] + built["build_shadow_rays"]
+    kept, fresh = np.array(kept), np.array(fresh)
+    mean = np.concatenate([kept, fresh]).mean(axis=0)
+    relvar = lambda images: float(np.mean(images.var(axis=0, ddof=1) / (mean ** 2 + 0.01)))  # noqa: E731
+    per_sample = relvar(kept) / relvar(fresh)
+    per_ray = per_sample * kept_rays / fresh_rays
+    print(f"kept map / fresh: relative variance per sample {per_sample:.3f}, per ray {per_ray:.3f} "
+          f"({kept_rays} / {fresh_rays} rays)")
+    assert per_sample < 1.5, per_sample  # about equal: the kept map only rejects from its first pass
+    assert per_ray < 0.5, (per_ray, kept_rays, fresh_rays)
+
+
 def test_live_render_cancel_stops_at_once():
     scene = neepp.load(DEMO, resx=64, resy=36)
     live = neepp._neepp.LiveRender(scene, "path", {}, 2, "", 0)
