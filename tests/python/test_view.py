@@ -510,6 +510,33 @@ def test_malformed_messages_are_refused(viewer, bad, expect):
     assert viewer["proc"].poll() is None
 
 
+def test_a_page_closed_and_reopened(viewer):
+    """Pages that go away (closed cleanly, or their connection dropped mid-stream, as a killed tab's) leave
+    the server serving: a page opened afterwards gets the state and frames, and its camera moves work."""
+    async def body():
+        async with aiohttp.ClientSession() as http:
+            for abrupt in (False, True, False):
+                ws = await http.ws_connect(viewer["url"] + "ws")
+                page = Page(ws)
+                await page.until(lambda m: m["type"] == "state", "the state")
+                await page.until(lambda m: m["type"] == "frame", "a frame")
+                await page.send({"type": "dolly", "amount": 0.01})  # frames flowing when it goes
+                if abrupt:
+                    ws._response.connection.transport.abort()  # no closing handshake
+                await ws.close()
+            async with http.ws_connect(viewer["url"] + "ws") as ws:
+                page = Page(ws)
+                state = await page.until(lambda m: m["type"] == "state", "the state on reopening")
+                frame = await page.until(full_frame(), "a frame on reopening")
+                await page.send({"type": "dolly", "amount": -0.03})
+                moved = await page.until(lambda m: m["type"] == "frame" and m["view"] > frame["view"], "a new view")
+                return state, moved
+
+    state, moved = run(body())
+    assert state["width"] == W and moved["view"] >= 1
+    assert viewer["proc"].poll() is None
+
+
 def test_an_oversized_message_closes_only_its_websocket(viewer):
     async def body():
         async with aiohttp.ClientSession() as http:
@@ -587,6 +614,18 @@ async def run_in_chromium(url, profile: Path, timeout=90.0):
                             verdict = text
                         asking = None
                         await asyncio.sleep(0.2)
+                # The page's own list of what it loaded too: the DevTools network events of its first
+                # requests can be missed when they come before Network.enable has taken effect.
+                listed = await call("Runtime.evaluate", returnByValue=True,
+                                    expression="performance.getEntriesByType('resource').map((e) => e.name)")
+                while verdict is not None and time.monotonic() < deadline:
+                    try:
+                        msg = await ws.receive_json(timeout=1.0)
+                    except asyncio.TimeoutError:
+                        continue
+                    if msg.get("id") == listed:
+                        urls.extend(msg.get("result", {}).get("result", {}).get("value") or [])
+                        break
     finally:
         proc.terminate()
         try:
