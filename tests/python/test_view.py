@@ -170,6 +170,32 @@ def test_live_render_map_view_reads_the_map(tmp_path):
     assert np.array_equal(np.isnan(row), np.isnan(expect))
     assert np.allclose(row[traced > 0], expect[traced > 0], rtol=1e-6)
     assert np.count_nonzero(traced > 0) > 0
+    # The page's heat map (ViewSession's, from the render thread, here called directly between renders): per
+    # pixel, the mean of Ṽ from its cell to the clicked cell and to the cells the clicked cell sees, over
+    # the pairs the map knows, as the file gives them.
+    from neepp_tools.view.session import ViewSession
+    session = ViewSession(neepp.load(DEMO, resx=32, resy=18), "path", {"shadow_rays": "neepp"}, max_spp=4, threads=2)
+    session.live.render(4)
+    result, heat = session._map_view(int(x), int(y))
+    assert session.live.save_visibility_map(tmp_path / "session.vis")
+    saved = neepp.VisibilityMap.load(tmp_path / "session.vis", scene, 16)
+    counts = saved.counts()
+
+    def estimates(a):
+        pairs = np.array([saved.pair_index(a, b) for b in range(info["cell_count"])])
+        v, t = counts[pairs, 0].astype(np.float64), counts[pairs, 1].astype(np.float64)
+        return np.where(t > 0, (v + 1) / (t + 2), np.nan)
+
+    clicked = estimates(result["cell"])
+    targets = sorted(set(np.flatnonzero(np.isfinite(clicked)).tolist()) | {result["cell"]})
+    table = np.array([estimates(b) for b in targets])  # (targets, cells)
+    known = np.isfinite(table).sum(axis=0)
+    per_cell = np.full(table.shape[1], np.nan)
+    per_cell[known > 0] = np.nansum(table, axis=0)[known > 0] / known[known > 0]
+    expect = np.where(cells >= 0, per_cell[np.maximum(cells, 0)], np.nan)
+    assert result["seen_cells"] == len(targets) - (0 if np.isfinite(clicked[result["cell"]]) else 1)
+    assert np.array_equal(np.isnan(heat), np.isnan(expect)) and np.isfinite(heat).any()
+    assert np.allclose(heat[np.isfinite(heat)], expect[np.isfinite(expect)], rtol=1e-5)
     with pytest.raises(IndexError):
         live.visibility_row(info["cell_count"])
     with pytest.raises(ValueError, match="outside"):

@@ -198,14 +198,16 @@ class ViewSession:
 
     def _seen_visibility(self, cell: int, cells: np.ndarray) -> np.ndarray:
         """The heat map of the map view: for each pixel, the mean of Ṽ from its first hit's cell to the
-        cells the clicked cell sees (those its row of the map knows: for NEE++ under a path tracer, the
-        cells of the light points its shadow rays went to), over the pairs the map knows; NaN where it
-        knows none. Where the clicked point's light is visible from, as the map has it: its shadows.
-        (Ṽ between the clicked cell and each pixel's own cell would be unknown almost everywhere: NEE++
-        learns pairs of a shading cell and a light cell only.)"""
+        clicked cell and to the cells the clicked cell sees (those its row of the map knows: for NEE++
+        under a path tracer, the cells of the light points its shadow rays went to), over the pairs the map
+        knows; NaN where it knows none. Clicked on a wall: where the light it sees is visible from, as the
+        map has it (that light's shadows); clicked on a light: Ṽ from each pixel to it. (Ṽ between a
+        wall's cell and each pixel's own cell alone would be unknown almost everywhere: NEE++ learns pairs
+        of a shading cell and a light cell only.)"""
         row = self.live.visibility_row(cell)
         seen = np.flatnonzero(np.isfinite(row))
         self._seen_count = int(seen.size)
+        seen = np.union1d(seen, [cell])
         total = np.zeros(row.shape, np.float64)
         count = np.zeros(row.shape, np.int64)
         for b in seen:
