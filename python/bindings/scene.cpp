@@ -61,11 +61,15 @@ void bind_scene(nb::module_ &m) {
                     d["power"] = vec(light->power());
                     d["infinite"] = light->is_infinite();
                     d["delta"] = light->is_delta();
+                    // Where it is, for tools that name a light (neepp view's light distribution); none for
+                    // infinite lights.
+                    if (const auto b = light->bounds()) d["center"] = vec(b->bounds.center());
                     lights.append(d);
                 }
                 return lights;
             },
-            "One dict per light (type: area, envmap, constant or point; power as RGB; infinite; delta).")
+            "One dict per light (type: area, envmap, constant or point; power as RGB; infinite; delta; center, the middle of "
+            "its bounds, for lights that have bounds).")
         .def_prop_ro("bounds", [](const Scene &s) { return nb::make_tuple(vec(s.bounds().lo), vec(s.bounds().hi)); },
                      "The scene's bounding box, ((x, y, z) low, (x, y, z) high).")
         .def_prop_ro("triangle_count", &Scene::triangle_count)

@@ -50,8 +50,12 @@ def start_view(neepp_bin, out_dir, *extra):
 @pytest.fixture(scope="module")
 def viewer(neepp_bin, tmp_path_factory):
     out = tmp_path_factory.mktemp("view")
-    proc, url, port = start_view(neepp_bin, out / "saved")
-    yield {"proc": proc, "url": url, "port": port, "out": out / "saved"}
+    # A reference of the film's size (not the scene's image: the relMSE need only be measured against it).
+    reference = np.full((H, W, 3), 0.05, np.float32)
+    reference[:, : W // 2] = 0.2
+    neepp.write_exr(out / "reference.exr", reference)
+    proc, url, port = start_view(neepp_bin, out / "saved", "--reference", str(out / "reference.exr"))
+    yield {"proc": proc, "url": url, "port": port, "out": out / "saved", "reference": reference}
     proc.send_signal(signal.SIGTERM)
     proc.wait(timeout=20)
 
@@ -64,9 +68,13 @@ class Page:
         self.state = None
 
     async def next(self, timeout=TIMEOUT):
-        msg = await self.ws.receive(timeout=timeout)
+        return await self._decode(await self.ws.receive(timeout=timeout))
+
+    async def _decode(self, msg):
         if msg.type == aiohttp.WSMsgType.BINARY:
             header, pixels = messages.decode_frame(msg.data)
+            if header.get("kind"):  # a map view or the reference, not a frame
+                return {"type": "binary", "header": header, "pixels": pixels}
             image = np.frombuffer(pixels, dtype="<f4").reshape(header["height"], header["width"], 3)
             return {"type": "frame", **header, "image": image}
         if msg.type == aiohttp.WSMsgType.TEXT:
@@ -131,6 +139,120 @@ def test_live_render_keeps_its_integrator_across_camera_moves():
     with pytest.raises(ValueError, match="fov"):
         live.set_camera(cam.to_world(), 200)
     assert scene.camera["fov"] == pytest.approx(cam.fov)  # a refused camera leaves the one in force
+
+
+def test_live_render_map_view_reads_the_map(tmp_path):
+    """The map view's parts: a pixel's first hit and its cell, the map's row of that cell (Ṽ to every cell,
+    NaN where unknown) equal to the map's counts as its file holds them, and the light distribution there."""
+    scene = neepp.load(DEMO, resx=32, resy=18)
+    live = neepp._neepp.LiveRender(scene, "path", {"shadow_rays": "neepp"}, 2, "", 0)
+    assert live.map_info() is None  # no map before the first render prepares it
+    live.render(4)
+    info = live.map_info()
+    assert info["resolution"] == 16 and info["known_pairs"] > 0
+    cells = live.pixel_cells()
+    assert cells.shape == (18, 32) and cells.dtype == np.int32
+    assert np.all((cells >= -1) & (cells < info["voxel_count"])) and np.count_nonzero(cells >= 0) > 0.9 * cells.size
+    # A pixel whose cell the map knows pairs of (NEE++ learns pairs of a shading cell and a light cell).
+    y, x = next((y, x) for y, x in np.argwhere(cells >= 0) if np.isfinite(live.visibility_row(cells[y, x])).any())
+    hit = live.pick(int(x), int(y))
+    assert hit["cell"] == cells[y, x] and len(hit["point"]) == 3
+    assert hit["light_pmf"].shape == (len(scene.lights),) and hit["light_pmf"].sum() == pytest.approx(1.0)
+    row = live.visibility_row(hit["cell"])
+    assert row.shape == (info["cell_count"],)
+    # The row against the map itself, read back from the file it saves (the project's map format).
+    assert live.save_visibility_map(tmp_path / "map.vis")
+    saved = neepp.VisibilityMap.load(tmp_path / "map.vis", scene, 16)
+    counts = saved.counts()
+    pairs = np.array([saved.pair_index(hit["cell"], b) for b in range(info["cell_count"])])
+    visible, traced = counts[pairs, 0].astype(np.float64), counts[pairs, 1].astype(np.float64)
+    expect = np.where(traced > 0, (visible + 1) / (traced + 2), np.nan)
+    assert np.array_equal(np.isnan(row), np.isnan(expect))
+    assert np.allclose(row[traced > 0], expect[traced > 0], rtol=1e-6)
+    assert np.count_nonzero(traced > 0) > 0
+    # The page's heat map (ViewSession's, from the render thread, here called directly between renders): per
+    # pixel, the mean of Ṽ from its cell to the clicked cell and to the cells the clicked cell sees, over
+    # the pairs the map knows, as the file gives them.
+    from neepp_tools.view.session import ViewSession
+    session = ViewSession(neepp.load(DEMO, resx=32, resy=18), "path", {"shadow_rays": "neepp"}, max_spp=4, threads=2)
+    session.live.render(4)
+    result, heat = session._map_view(int(x), int(y))
+    assert session.live.save_visibility_map(tmp_path / "session.vis")
+    saved = neepp.VisibilityMap.load(tmp_path / "session.vis", scene, 16)
+    counts = saved.counts()
+
+    def estimates(a):
+        pairs = np.array([saved.pair_index(a, b) for b in range(info["cell_count"])])
+        v, t = counts[pairs, 0].astype(np.float64), counts[pairs, 1].astype(np.float64)
+        return np.where(t > 0, (v + 1) / (t + 2), np.nan)
+
+    clicked = estimates(result["cell"])
+    targets = sorted(set(np.flatnonzero(np.isfinite(clicked)).tolist()) | {result["cell"]})
+    table = np.array([estimates(b) for b in targets])  # (targets, cells)
+    known = np.isfinite(table).sum(axis=0)
+    per_cell = np.full(table.shape[1], np.nan)
+    per_cell[known > 0] = np.nansum(table, axis=0)[known > 0] / known[known > 0]
+    expect = np.where(cells >= 0, per_cell[np.maximum(cells, 0)], np.nan)
+    assert result["seen_cells"] == len(targets) - (0 if np.isfinite(clicked[result["cell"]]) else 1)
+    assert np.array_equal(np.isnan(heat), np.isnan(expect)) and np.isfinite(heat).any()
+    assert np.allclose(heat[np.isfinite(heat)], expect[np.isfinite(expect)], rtol=1e-5)
+    with pytest.raises(IndexError):
+        live.visibility_row(info["cell_count"])
+    with pytest.raises(ValueError, match="outside"):
+        live.pick(32, 0)
+    # No map where the integrator keeps none (plain NEE, the bvh light sampler); a pick still answers.
+    plain = neepp._neepp.LiveRender(neepp.load(DEMO, resx=32, resy=18), "path", {}, 2, "", 0)
+    plain.render(1)
+    assert plain.map_info() is None and plain.pick(13, 11)["cell"] == -1
+    assert not plain.save_visibility_map(tmp_path / "none.vis") and not (tmp_path / "none.vis").exists()
+    with pytest.raises(RuntimeError, match="no visibility map"):
+        plain.pixel_cells()
+
+
+def test_live_render_a_kept_map_makes_a_new_views_first_frames_cheaper():
+    """The map kept across a camera move, against a fresh NEE++ render of the new view, over the first 4
+    samples per pixel, at 6 seeds each (independent renders; the per-pixel variance across them). Equal
+    samples cost the two different amounts: a fresh render seeds its map (camera paths and shadow rays) and
+    traces every shadow ray of its first pass (the probe), while the kept map skips rays from the first
+    pass. Their cost is counted in rays traced (camera paths, shadow rays, seeding), not in seconds, so the
+    test does not depend on the machine's load. Per sample the two are about equally noisy (the fresh
+    render's probe pass traces every shadow ray; the kept map skips some of them), per ray traced the kept
+    map is far ahead, which is what a person moving the camera sees: the first frames of the new view
+    arrive sooner. Deterministic: fixed seeds, and the renderer gives the same image on any thread count."""
+    def render(live, spp):
+        images = []
+        stats = json.loads(live.render(spp, on_frame=lambda image, info: images.append(image) if info["final"] else None))
+        return images[-1], stats
+
+    kept, fresh, kept_rays, fresh_rays = [], [], 0, 0
+    for seed in range(6):
+        scene = neepp.load(DEMO, resx=48, resy=27)
+        cam = OrbitCamera(scene.camera["to_world"], scene.camera["fov"], scene.bounds)
+        cam.orbit(0.15, 0.03)
+        live = neepp._neepp.LiveRender(scene, "path", {"shadow_rays": "neepp"}, 2, "", 100 + seed)
+        live.render(32)  # the first view: the map learns
+        live.set_camera(cam.to_world(), cam.fov)
+        image, stats = render(live, 4)
+        # The map carried over (it went on merging what the first view learned) and was not seeded again.
+        assert stats["integrator_statistics"]["shadow_rays"]["roulette"]["passes_merged"] > stats["passes"]
+        kept.append(image)
+        kept_rays += stats["rays"] + stats["shadow_rays"]
+        other = neepp._neepp.LiveRender(neepp.load(DEMO, resx=48, resy=27), "path", {"shadow_rays": "neepp"}, 2, "",
+                                        200 + seed)
+        other.set_camera(cam.to_world(), cam.fov)
+        image, stats = render(other, 4)
+        fresh.append(image)
+        built = stats["integrator_statistics"]["shadow_rays"]["map"]
+        fresh_rays += stats["rays"] + stats["shadow_rays"] + built["build_camera_rays"] + built["build_shadow_rays"]
+    kept, fresh = np.array(kept), np.array(fresh)
+    mean = np.concatenate([kept, fresh]).mean(axis=0)
+    relvar = lambda images: float(np.mean(images.var(axis=0, ddof=1) / (mean ** 2 + 0.01)))  # noqa: E731
+    per_sample = relvar(kept) / relvar(fresh)
+    per_ray = per_sample * kept_rays / fresh_rays
+    print(f"kept map / fresh: relative variance per sample {per_sample:.3f}, per ray {per_ray:.3f} "
+          f"({kept_rays} / {fresh_rays} rays)")
+    assert per_sample < 1.5, per_sample  # about equal: the kept map only rejects from its first pass
+    assert per_ray < 0.5, (per_ray, kept_rays, fresh_rays)
 
 
 def test_live_render_cancel_stops_at_once():
@@ -274,14 +396,30 @@ def test_an_option_change_changes_the_statistics(viewer):
     assert kept["options"] == {"shadow_rays": "neepp-adaptive"}
 
 
-def test_save_writes_exr_png_and_statistics(viewer):
+def test_save_writes_exr_png_statistics_and_the_map(viewer):
     async def body(page):
         await page.until(full_frame(), "a full frame")
         await page.send({"type": "save", "exposure": 1.0})
-        return await page.until(lambda m: m["type"] in ("saved", "error"), "the save")
+        plain = await page.until(lambda m: m["type"] in ("saved", "error"), "the save")
+        # With NEE++ the map is saved too, in the project's map format.
+        await page.send({"type": "options", "integrator": "path", "options": {"shadow_rays": "neepp"}})
+        await page.until(lambda m: full_frame()(m) and m["options"].get("shadow_rays") == "neepp", "a NEE++ frame")
+        await page.send({"type": "save"})
+        with_map = await page.until(lambda m: m["type"] in ("saved", "error"), "the save with the map")
+        await page.send({"type": "options", "integrator": "path", "options": {}})
+        await page.until(lambda m: m["type"] == "state" and not m["options"], "the scene's options")
+        return plain, with_map
 
-    saved = run(with_page(viewer["url"], body))
+    saved, with_map = run(with_page(viewer["url"], body))
     assert saved["type"] == "saved", saved
+    assert with_map["type"] == "saved", with_map
+    assert [Path(f).suffix for f in with_map["files"]] == [".exr", ".png", ".json", ".vis"]
+    record = json.loads(Path(with_map["files"][2]).read_text())
+    assert record["visibility_map"]["file"] == Path(with_map["files"][3]).name
+    scene = neepp.load(DEMO, resx=W, resy=H)
+    loaded = neepp.VisibilityMap.load(with_map["files"][3], scene, record["visibility_map"]["resolution"])
+    assert loaded.known_pairs == record["visibility_map"]["known_pairs"] > 0
+    assert record["shadow_rays"] > 0 and neepp.read_exr(with_map["files"][0]).shape[:2] == (H, W)
     exr, png, stats = (Path(f) for f in saved["files"])
     assert exr.suffix == ".exr" and png.suffix == ".png" and stats.suffix == ".json"
     assert exr.parent == viewer["out"]
@@ -291,6 +429,74 @@ def test_save_writes_exr_png_and_statistics(viewer):
     record = json.loads(stats.read_text())
     assert record["spp"] >= 1 and record["exposure"] == 1.0 and len(record["to_world"]) == 4
     assert record["scene"].endswith("scene.xml") and "shadow_rays" in record and "integrator" in record
+    assert "visibility_map" not in record  # plain NEE keeps no map
+
+
+def test_a_click_shows_the_map_view(viewer):
+    """A pick (the page's click) is answered with the heat map of Ṽ from the clicked point's cell over the
+    image, and the light distribution there; the image goes on converging (a pick does not restart it)."""
+    async def body(page):
+        await page.send({"type": "options", "integrator": "path", "options": {"shadow_rays": "neepp"}})
+        before = await page.until(lambda m: full_frame()(m) and m["options"].get("shadow_rays") == "neepp", "a frame")
+        await page.send({"type": "pick", "x": W * 2 // 5, "y": H * 3 // 5})
+        mapped = await page.until(lambda m: m["type"] == "binary" and m["header"]["kind"] == "map", "the map view")
+        header, data = mapped["header"], mapped["pixels"]
+        after = await page.until(lambda m: full_frame(before["view"])(m) and m["spp"] > before["spp"], "more samples")
+        await page.send({"type": "pick", "x": W, "y": 0})
+        error = await page.until(lambda m: m["type"] == "error", "the refusal of a pixel outside")
+        await page.send({"type": "options", "integrator": "path", "options": {}})
+        await page.until(lambda m: m["type"] == "state" and not m["options"], "the scene's options")
+        return before, header, data, after, error
+
+    before, header, data, after, error = run(with_page(viewer["url"], body))
+    assert header["hit"] and header["cell"] >= 0 and header["map"]["resolution"] == 16
+    assert (header["width"], header["height"], header["channels"]) == (W, H, 1)
+    heat = np.frombuffer(data, dtype="<f4").reshape(H, W)
+    known = heat[np.isfinite(heat)]
+    assert known.size > 0.5 * heat.size and np.all((known > 0) & (known < 1))
+    assert known.max() - known.min() > 0.3, (known.min(), known.max())
+    assert header["known_fraction"] == pytest.approx(known.size / heat.size)
+    assert [light["pmf"] for light in header["lights"]] == [1.0] and header["light_count"] == 1
+    assert after["view"] == before["view"]  # the image was not restarted
+    assert "outside" in error["message"]
+
+
+def test_the_relmse_against_a_reference_or_a_saved_image(viewer):
+    from neepp_tools.metrics import relmse
+
+    def binary(kind):
+        def test(m):
+            return m["type"] == "binary" and m["header"].get("kind") == kind
+        return test
+
+    async def body(page):
+        first = await page.until(binary("reference"), "the reference, sent on connecting")
+        framed = await page.until(lambda m: full_frame()(m) and "relmse" in m, "a frame with its relMSE")
+        await page.send({"type": "reference", "source": "none"})
+        await page.until(binary("reference"), "no reference")
+        await page.until(lambda m: m["type"] == "state" and m["reference"] is None, "the state without one")
+        bare = await page.until(full_frame(), "a frame")
+        bare = await page.until(full_frame(), "a frame measured against nothing")
+        await page.send({"type": "save"})
+        saved = await page.until(lambda m: m["type"] in ("saved", "error"), "the save")
+        await page.send({"type": "reference", "source": "saved"})
+        stored = await page.until(binary("reference"), "the saved image as the reference")
+        against = await page.until(lambda m: full_frame()(m) and "relmse" in m, "a frame against it")
+        return first, framed, bare, saved, stored, against
+
+    first, framed, bare, saved, stored, against = run(with_page(viewer["url"], body))
+    ref = np.frombuffer(first["pixels"], dtype="<f4").reshape(H, W, 3)
+    assert np.array_equal(ref, viewer["reference"]) and first["header"]["name"].endswith("reference.exr")
+    assert framed["relmse"] == pytest.approx(relmse(framed["image"], viewer["reference"]), rel=1e-9)
+    assert framed["relmse"] > 0.1 and framed["reference"].endswith("reference.exr")
+    assert "relmse" not in bare
+    assert saved["type"] == "saved", saved
+    image = neepp.read_exr(saved["files"][0])[..., :3]
+    stored_image = np.frombuffer(stored["pixels"], dtype="<f4").reshape(H, W, 3)
+    assert np.array_equal(stored_image, image) and "as saved" in stored["header"]["name"]
+    # Against the image it converges to: small, and the same number as neepp compare's metric gives.
+    assert against["relmse"] == pytest.approx(relmse(against["image"], image), rel=1e-9)
+    assert against["relmse"] < framed["relmse"]
 
 
 @pytest.mark.parametrize("bad, expect", [
@@ -306,6 +512,9 @@ def test_save_writes_exr_png_and_statistics(viewer):
     ('{"type": "options", "integrator": "", "options": {}}', "'integrator'"),
     ('{"type": "options", "integrator": "no-such", "options": {}}', "no-such"),
     ("[" * 5000 + "]" * 5000, "not JSON"),  # deeper than the parser goes
+    ('{"type": "pick", "x": 1.5, "y": 0}', "pixel index"),
+    ('{"type": "pick", "x": -1, "y": 0}', "pixel index"),
+    ('{"type": "reference", "source": "/etc/passwd"}', "'source'"),
     (b"\x00\x01binary", "JSON text"),
 ])
 def test_malformed_messages_are_refused(viewer, bad, expect):
@@ -324,6 +533,33 @@ def test_malformed_messages_are_refused(viewer, bad, expect):
 
     error = run(with_page(viewer["url"], body))
     assert expect in error["message"], error
+    assert viewer["proc"].poll() is None
+
+
+def test_a_page_closed_and_reopened(viewer):
+    """Pages that go away (closed cleanly, or their connection dropped mid-stream, as a killed tab's) leave
+    the server serving: a page opened afterwards gets the state and frames, and its camera moves work."""
+    async def body():
+        async with aiohttp.ClientSession() as http:
+            for abrupt in (False, True, False):
+                ws = await http.ws_connect(viewer["url"] + "ws")
+                page = Page(ws)
+                await page.until(lambda m: m["type"] == "state", "the state")
+                await page.until(lambda m: m["type"] == "frame", "a frame")
+                await page.send({"type": "dolly", "amount": 0.01})  # frames flowing when it goes
+                if abrupt:
+                    ws._response.connection.transport.abort()  # no closing handshake
+                await ws.close()
+            async with http.ws_connect(viewer["url"] + "ws") as ws:
+                page = Page(ws)
+                state = await page.until(lambda m: m["type"] == "state", "the state on reopening")
+                frame = await page.until(full_frame(), "a frame on reopening")
+                await page.send({"type": "dolly", "amount": -0.03})
+                moved = await page.until(lambda m: m["type"] == "frame" and m["view"] > frame["view"], "a new view")
+                return state, moved
+
+    state, moved = run(body())
+    assert state["width"] == W and moved["view"] >= 1
     assert viewer["proc"].poll() is None
 
 
@@ -404,6 +640,18 @@ async def run_in_chromium(url, profile: Path, timeout=90.0):
                             verdict = text
                         asking = None
                         await asyncio.sleep(0.2)
+                # The page's own list of what it loaded too: the DevTools network events of its first
+                # requests can be missed when they come before Network.enable has taken effect.
+                listed = await call("Runtime.evaluate", returnByValue=True,
+                                    expression="performance.getEntriesByType('resource').map((e) => e.name)")
+                while verdict is not None and time.monotonic() < deadline:
+                    try:
+                        msg = await ws.receive_json(timeout=1.0)
+                    except asyncio.TimeoutError:
+                        continue
+                    if msg.get("id") == listed:
+                        urls.extend(msg.get("result", {}).get("result", {}).get("value") or [])
+                        break
     finally:
         proc.terminate()
         try:
@@ -416,8 +664,8 @@ async def run_in_chromium(url, profile: Path, timeout=90.0):
 
 def test_page_in_headless_chromium(viewer, tmp_path):
     """The page's own self-test (#selftest) in a real browser: frames converge, a mouse drag restarts the
-    view, switching the shadow-ray policy to neepp-adaptive shows shadow rays skipped; no console error,
-    and nothing requested from anywhere but the server."""
+    view, switching the shadow-ray policy to neepp-adaptive shows shadow rays skipped, a click shows the
+    map's heat map over the image; no console error, and nothing requested from anywhere but the server."""
     verdict, problems, urls = run(run_in_chromium(viewer["url"] + "#selftest", tmp_path / "profile"))
     assert verdict and verdict.startswith("selftest ok"), (verdict, problems)
     assert not problems, problems
@@ -452,6 +700,13 @@ def test_a_port_in_use_is_a_clear_error(neepp_bin, tmp_path):
         r = subprocess.run([str(neepp_bin), "view", str(DEMO), "-D", f"resx={W}", "-D", f"resy={H}", "--port", str(port)],
                            capture_output=True, text=True, timeout=60)
     assert r.returncode == 1 and f"127.0.0.1:{port}" in r.stderr and "Traceback" not in r.stderr, r.stderr
+
+
+def test_a_reference_of_another_size_is_a_clear_error(neepp_bin, tmp_path):
+    neepp.write_exr(tmp_path / "small.exr", np.zeros((4, 4, 3), np.float32))
+    r = subprocess.run([str(neepp_bin), "view", str(DEMO), "-D", f"resx={W}", "-D", f"resy={H}", "--reference",
+                        str(tmp_path / "small.exr")], capture_output=True, text=True, timeout=60)
+    assert r.returncode == 1 and "4x4" in r.stderr and f"{W}x{H}" in r.stderr and "Traceback" not in r.stderr, r.stderr
 
 
 def test_without_its_python_modules_it_says_what_is_missing(neepp_bin, tmp_path):

@@ -44,8 +44,11 @@ def parse_args(argv):
     p.add_argument("--spp", type=int, default=1024, help="The most samples per pixel a view gets (default 1024)")
     p.add_argument("--threads", type=int, default=0, help="Worker threads (default: all cores)")
     p.add_argument("--seed", type=int, default=None, help="Random seed (default: the scene's)")
+    p.add_argument("--reference", type=Path, default=None,
+                   help="A reference image (EXR) of the scene's camera and film: the page shows the image's "
+                        "relMSE against it and its per-pixel map")
     p.add_argument("-o", "--output-dir", type=Path, default=Path("neepp-view"),
-                   help="Where the save button writes view_NNN.exr, .png and .json (default neepp-view)")
+                   help="Where the save button writes view_NNN.exr, .png, .json and .vis (NEE++'s map) (default neepp-view)")
     a = p.parse_args(argv)
     if not 0 <= a.port <= 65535:
         p.error(f"--port {a.port}: not a port (0..65535)")
@@ -59,6 +62,8 @@ def parse_args(argv):
         p.error(str(e))
     if not a.scene.is_file():
         p.error(f"scene file {a.scene} does not exist")
+    if a.reference is not None and not a.reference.is_file():
+        p.error(f"reference image {a.reference} does not exist")
     return a
 
 
@@ -75,7 +80,9 @@ def main(argv=None) -> int:
         scene = neepp.load(a.scene, **a.define)
         session = ViewSession(scene, a.integrator, a.option, max_spp=a.spp, threads=a.threads, seed=a.seed,
                               output_dir=a.output_dir)
-    except (ValueError, RuntimeError) as e:
+        if a.reference is not None:
+            session.set_reference(neepp.read_exr(a.reference), str(a.reference))
+    except (ValueError, RuntimeError, OSError) as e:
         print(f"neepp: error: {e}", file=sys.stderr)
         return 1
     sock.listen(16)

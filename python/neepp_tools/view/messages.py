@@ -11,10 +11,15 @@ malformed one is answered with an error and changes nothing):
     {"type": "reset"}                                the scene's own camera
     {"type": "options", "integrator": NAME, "options": {KEY: VALUE}}   switch the integrator's options
     {"type": "save", "exposure": STOPS}              write the image (EXR, PNG at that exposure, JSON)
+    {"type": "pick", "x": X, "y": Y}                 the map view from pixel (X, Y) of the full image
+    {"type": "reference", "source": "saved" | "none"}   measure the relMSE against the last image saved, or not
 
-The server sends JSON text ({"type": "state" | "error" | "saved", ...}) and the frames, in binary: a
-little-endian uint32 n, n bytes of JSON (the frame's statistics), zero bytes up to a multiple of 4, then
-the linear RGB pixels as little-endian float32, row by row from the top.
+The server sends JSON text ({"type": "state" | "error" | "saved", ...}) and binary messages: a
+little-endian uint32 n, n bytes of JSON (the header), spaces up to a multiple of 4, then the header's
+width x height x channels little-endian float32, row by row from the top. A frame's header holds its
+statistics and its pixels are linear RGB (channels absent: 3); a map view's header has "kind": "map" (the
+clicked point, its cell, its light distribution) and one channel, Ṽ per pixel (NaN where unknown; width
+and height 0 without a map); the reference's has "kind": "reference" and RGB (width and height 0: none).
 """
 from __future__ import annotations
 
@@ -35,6 +40,7 @@ CAMERA_COMMANDS = {
     "reset": {},
 }
 MAX_OPTIONS = 32
+MAX_PIXEL = 1 << 16
 MAX_TEXT = 200
 
 
@@ -49,6 +55,13 @@ def _number(msg: dict, key: str, limit: float) -> float:
     if abs(v) > limit:
         raise BadMessage(f"'{msg['type']}': '{key}' = {v} is out of range (at most {limit:g} in magnitude)")
     return float(v)
+
+
+def _pixel(msg: dict, key: str) -> int:
+    v = msg.get(key)
+    if isinstance(v, bool) or not isinstance(v, int) or not 0 <= v <= MAX_PIXEL:
+        raise BadMessage(f"'{msg['type']}' needs a pixel index '{key}' (an integer, 0 to {MAX_PIXEL})")
+    return v
 
 
 def _text(v, what: str) -> str:
@@ -78,6 +91,13 @@ def parse(text) -> dict:
             raise BadMessage("'options' needs an object of at most 32 key: value strings")
         return {"type": "options", "integrator": _text(msg.get("integrator"), "'integrator'"),
                 "options": {_text(k, "an option's name"): _text(v, f"option '{k}'") for k, v in options.items()}}
+    if kind == "pick":
+        return {"type": "pick", "x": _pixel(msg, "x"), "y": _pixel(msg, "y")}
+    if kind == "reference":
+        source = msg.get("source")
+        if source not in ("saved", "none"):
+            raise BadMessage("'reference' needs a 'source': 'saved' or 'none'")
+        return {"type": "reference", "source": source}
     if kind == "save":
         return {"type": "save", "exposure": _number(msg, "exposure", 64.0) if "exposure" in msg else 0.0}
     raise BadMessage(f"unknown message type '{kind[:40]}'")
@@ -88,6 +108,24 @@ def encode_frame(header: dict, pixels: bytes) -> bytes:
     head = json.dumps(header, separators=(",", ":")).encode()
     head += b" " * (-(len(head) + 4) % 4)  # JSON ignores trailing spaces; the pixels start 4-aligned
     return struct.pack("<I", len(head)) + head + pixels
+
+
+def encode_map(result: dict, heat) -> bytes:
+    """A map view's binary message: its header (kind "map") and the heat map, one float32 channel."""
+    if heat is None:
+        return encode_frame({**result, "kind": "map", "width": 0, "height": 0, "channels": 1}, b"")
+    h, w = heat.shape
+    return encode_frame({**result, "kind": "map", "width": w, "height": h, "channels": 1},
+                        heat.astype("<f4", copy=False).tobytes())
+
+
+def encode_reference(name: str, image) -> bytes:
+    """The reference's binary message (kind "reference"): its RGB pixels, or none."""
+    if image is None:
+        return encode_frame({"kind": "reference", "name": None, "width": 0, "height": 0, "channels": 3}, b"")
+    h, w = image.shape[:2]
+    return encode_frame({"kind": "reference", "name": name, "width": w, "height": h, "channels": 3},
+                        image.astype("<f4", copy=False).tobytes())
 
 
 def decode_frame(data: bytes):

@@ -22,17 +22,22 @@ PAGE_FILES = {"/": ("index.html", "text/html"), "/view.js": ("view.js", "text/ja
 
 
 class Client:
-    """One open page: what is to be sent to it, by a task of its own, in order (text first, then the
+    """One open page: what is to be sent to it, by a task of its own, in order (messages first, then the
     newest frame), so that a slow page never holds up the others or the render."""
 
     def __init__(self, ws: web.WebSocketResponse):
         self.ws = ws
-        self.texts: list[dict] = []
+        self.texts: list = []  # JSON messages (dicts) and binary ones (bytes, e.g. a map view), in order
         self.frame: bytes | None = None
         self.wake = asyncio.Event()
 
     def send_text(self, msg: dict) -> None:
         self.texts.append(msg)
+        self.wake.set()
+
+    def send_binary(self, data: bytes) -> None:
+        """A binary message that, unlike a frame, is never replaced by a newer one."""
+        self.texts.append(data)
         self.wake.set()
 
     def send_frame(self, data: bytes) -> None:
@@ -45,7 +50,11 @@ class Client:
                 await self.wake.wait()
                 self.wake.clear()
                 while self.texts:
-                    await self.ws.send_json(self.texts.pop(0))
+                    msg = self.texts.pop(0)
+                    if isinstance(msg, bytes):
+                        await self.ws.send_bytes(msg)
+                    else:
+                        await self.ws.send_json(msg)
                 if self.frame is not None:
                     data, self.frame = self.frame, None
                     await self.ws.send_bytes(data)
@@ -107,6 +116,8 @@ class ViewServer:
         self.clients.add(client)
         pump = asyncio.create_task(client.pump())
         client.send_text(self.session.state())
+        if self.session.reference is not None:
+            client.send_binary(messages.encode_reference(self.session.reference_name, self.session.reference))
         latest = self.session.latest
         if latest is not None:
             client.send_frame(messages.encode_frame(latest.stats, latest.image.astype("<f4", copy=False).tobytes()))
@@ -134,6 +145,28 @@ class ViewServer:
             self.session.camera_command(command)
         elif kind == "options":
             self.session.set_options(command["integrator"], command["options"])
+        elif kind == "pick":
+            # Answered by the render thread between passes (a pass's length at most): the image goes on.
+            try:
+                result, heat = await asyncio.wait_for(
+                    asyncio.wrap_future(self.session.map_view(command["x"], command["y"])), 60)
+            except (ValueError, RuntimeError, IndexError, asyncio.TimeoutError) as e:
+                client.send_text({"type": "error", "message": f"map view: {e}"})
+            else:
+                client.send_binary(messages.encode_map(result, heat))
+        elif kind == "reference":
+            try:
+                if command["source"] == "saved":
+                    self.session.reference_from_saved()
+                else:
+                    self.session.set_reference(None, "")
+            except ValueError as e:
+                client.send_text({"type": "error", "message": f"reference: {e}"})
+                return
+            data = messages.encode_reference(self.session.reference_name, self.session.reference)
+            for c in list(self.clients):  # every page shows the same view, and measures it the same way
+                c.send_binary(data)
+                c.send_text(self.session.state())
         elif kind == "save":
             try:
                 files = await asyncio.get_running_loop().run_in_executor(None, self.session.save, command["exposure"])

@@ -74,6 +74,8 @@ public:
                      const PathVertex &sampled, int s, int t) const;
     const BidirContext &context() const { return ctx_; }
     ShadowRayTester &shadow_rays() { return *shadow_; }
+    // The light choice of its s = 1 strategies (null before prepare()), for tools that show its distribution.
+    const LightSampler *light_sampler() const { return light_sampler_.get(); }
 
 private:
     // Light tracing's only camera-side term: the infinite lights the camera ray sees directly.

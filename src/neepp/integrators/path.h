@@ -67,6 +67,8 @@ public:
     const PathOptions &options() const { return options_; }
     const ShadowRayTester &shadow_rays() const { return *shadow_; }
     ShadowRayTester &shadow_rays() { return *shadow_; }
+    // The light choice NEE makes (null before prepare()), for tools that show its distribution.
+    const LightSampler *light_sampler() const { return light_sampler_.get(); }
 
 private:
     friend class PathBatch;

@@ -9,7 +9,11 @@ const ctx = canvas.getContext("2d");
 let ws = null;
 let state = null;           // the server's latest "state" message
 let frame = null;           // {header, pixels: Float32Array} of the newest frame
+let mapView = null;         // {header, pixels: Float32Array} of the last map view (a clicked point)
+let reference = null;       // {header, pixels: Float32Array}: the image the relMSE is measured against
+let overlay = null;         // what draw() last laid over the image: {view, known, min, max}
 const listeners = [];       // the self-test's waits: functions called with each frame
+const mapListeners = [];    // ... and with each map view
 
 // ---- frames -------------------------------------------------------------------------------------------
 
@@ -17,7 +21,7 @@ function decodeFrame(buffer) {
   const view = new DataView(buffer);
   const n = view.getUint32(0, true);
   const header = JSON.parse(new TextDecoder().decode(new Uint8Array(buffer, 4, n)));
-  const pixels = new Float32Array(buffer, 4 + n, header.width * header.height * 3);
+  const pixels = new Float32Array(buffer, 4 + n, header.width * header.height * (header.channels || 3));
   return { header, pixels };
 }
 
@@ -44,7 +48,133 @@ function draw() {
     dst[j + 2] = 255 * srgb(Math.min(1, Math.max(0, src[i + 2] * scale))) + 0.5;
     dst[j + 3] = 255;
   }
+  overlay = null;
+  if ($("mode").value === "map") drawMap(img.data, width, height);
+  else if ($("mode").value === "relmse") drawRelmse(img.data, width, height);
   ctx.putImageData(img, 0, 0);
+}
+
+// Ṽ in [0, 1] as a colour: dark blue (the map says occluded) through red to pale yellow (visible).
+const HEAT_STOPS = [[0, [20, 24, 110]], [0.5, [200, 55, 60]], [1, [255, 240, 130]]];
+function heatColor(v) {
+  for (let i = 1; i < HEAT_STOPS.length; i++) {
+    const [t1, c1] = HEAT_STOPS[i], [t0, c0] = HEAT_STOPS[i - 1];
+    if (v <= t1 || i === HEAT_STOPS.length - 1) {
+      const f = Math.min(1, Math.max(0, (v - t0) / (t1 - t0)));
+      return [c0[0] + f * (c1[0] - c0[0]), c0[1] + f * (c1[1] - c0[1]), c0[2] + f * (c1[2] - c0[2])];
+    }
+  }
+}
+
+// The map view over the image: each pixel tinted by Ṽ from the cell of what it sees to the cells the
+// clicked point sees (the light cells its shadow rays reach): the clicked point's light as the map sees it.
+// The image, in grey, shows through; pixels the map knows nothing of stay grey and dim. Only over a full
+// frame of the view it was computed for: after a move, the pixels see other cells.
+function drawMap(dst, width, height) {
+  if (!mapView || !mapView.header.width) return;
+  const h = mapView.header;
+  if (h.view !== frame.header.view || h.width !== width || h.height !== height) return;
+  const heat = mapView.pixels;
+  let known = 0, min = Infinity, max = -Infinity;
+  for (let i = 0, j = 0; i < heat.length; i++, j += 4) {
+    const grey = 0.3 * dst[j] + 0.55 * dst[j + 1] + 0.15 * dst[j + 2];
+    const v = heat[i];
+    if (Number.isNaN(v)) {
+      dst[j] = dst[j + 1] = dst[j + 2] = 0.4 * grey;
+      continue;
+    }
+    known++;
+    min = Math.min(min, v);
+    max = Math.max(max, v);
+    const c = heatColor(v);
+    dst[j] = 0.3 * grey + 0.7 * c[0];
+    dst[j + 1] = 0.3 * grey + 0.7 * c[1];
+    dst[j + 2] = 0.3 * grey + 0.7 * c[2];
+  }
+  // The clicked pixel: a small white cross.
+  for (let d = -3; d <= 3; d++) {
+    for (const [x, y] of [[h.x + d, h.y], [h.x, h.y + d]]) {
+      if (x < 0 || y < 0 || x >= width || y >= height) continue;
+      const j = 4 * (y * width + x);
+      dst[j] = dst[j + 1] = dst[j + 2] = 255;
+    }
+  }
+  overlay = { view: h.view, known, min, max };
+}
+
+// The per-pixel relMSE against the reference, as neepp compare's relMSE map defines it (squared error over
+// reference² + 0.01, averaged over the channels), on a log scale from 1e-4 (dark) to 1 (bright); the mean
+// of these is the relMSE the statistics show.
+const RELMSE_EPS = 0.01;
+function drawRelmse(dst, width, height) {
+  if (!reference || reference.header.width !== width || reference.header.height !== height) return;
+  const a = frame.pixels, r = reference.pixels;
+  let sum = 0;
+  for (let i = 0, j = 0; i < a.length; i += 3, j += 4) {
+    let e = 0;
+    for (let c = 0; c < 3; c++) {
+      const d = a[i + c] - r[i + c];
+      e += d * d / (r[i + c] * r[i + c] + RELMSE_EPS);
+    }
+    e /= 3;
+    sum += e;
+    const col = heatColor((Math.log10(Math.max(e, 1e-4)) + 4) / 4);
+    dst[j] = col[0];
+    dst[j + 1] = col[1];
+    dst[j + 2] = col[2];
+  }
+  overlay = { view: frame.header.view, relmse: sum / (width * height) };
+}
+
+function showReference(m) {
+  reference = m.header.width ? m : null;
+  $("reference").textContent = reference ? "reference: " + m.header.name
+    : "no reference (neepp view --reference FILE, or a saved image)";
+  draw();
+}
+
+function showMap(m) {
+  mapView = m;
+  const h = m.header;
+  $("map-panel").hidden = false;
+  const fmt = (v) => v.map((x) => x.toFixed(3)).join(", ");
+  $("map-point").textContent = h.hit
+    ? `pixel (${h.x}, ${h.y}) of view ${h.view}: point (${fmt(h.point)})` + (h.cell >= 0 ? `, cell ${h.cell}` : "")
+    : `pixel (${h.x}, ${h.y}) of view ${h.view}: its ray leaves the scene`;
+  let summary = "";
+  if (!h.map) summary = "This integrator keeps no visibility map (choose a NEE++ shadow-ray policy).";
+  else if (h.hit) summary = `This cell sees ${h.seen_cells} cells; Ṽ to them known for ` +
+      `${(100 * h.known_fraction).toFixed(1)} % of the pixels` +
+      (h.heat_mean !== null ? `, mean ${h.heat_mean.toFixed(3)}` : "") +
+      ` (map ${h.map.resolution}³ voxels, ${formatCount(h.map.known_pairs)} pairs known)`;
+  $("map-summary").textContent = summary;
+  const rows = [];
+  if (h.lights) {
+    const head = document.createElement("tr");
+    head.innerHTML = "<th>light</th><th>type</th><th>probability</th>";
+    rows.push(head);
+    for (const l of h.lights) {
+      const tr = document.createElement("tr");
+      for (const text of ["#" + l.index, l.type, (100 * l.pmf).toFixed(2) + " %"]) {
+        const td = document.createElement("td");
+        td.textContent = text;
+        tr.append(td);
+      }
+      if (l.center) tr.title = "centre " + fmt(l.center);
+      rows.push(tr);
+    }
+    const note = document.createElement("tr");
+    const td = document.createElement("td");
+    td.colSpan = 3;
+    td.className = "dim";
+    td.textContent = `${h.light_sampler}: the ${h.lights.length} most probable of ${h.light_count} lights`;
+    note.append(td);
+    rows.push(note);
+  }
+  $("map-lights").replaceChildren(...rows);
+  if (h.width) $("mode").value = "map";
+  draw();
+  for (const f of mapListeners.slice()) f(h);
 }
 
 function formatCount(n) {
@@ -70,6 +200,7 @@ function showStats(h) {
     shadow_rays_skipped: formatCount(h.shadow_rays_skipped) + percent(h.shadow_rays_skipped, tested),
     shadow_rays_occluded: formatCount(h.shadow_rays_occluded) + percent(h.shadow_rays_occluded, h.shadow_rays),
     fov: h.fov.toFixed(1) + "°",
+    relmse: h.relmse === undefined ? "–" : h.relmse.toExponential(3),
   };
   for (const td of document.querySelectorAll("#stats td")) {
     const key = td.dataset.key;
@@ -138,7 +269,10 @@ function connect() {
   };
   ws.onmessage = (event) => {
     if (event.data instanceof ArrayBuffer) {
-      frame = decodeFrame(event.data);
+      const decoded = decodeFrame(event.data);
+      if (decoded.header.kind === "map") { showMap(decoded); return; }
+      if (decoded.header.kind === "reference") { showReference(decoded); return; }
+      frame = decoded;
       draw();
       showStats(frame.header);
       for (const f of listeners.slice()) f(frame.header);
@@ -175,8 +309,21 @@ function flush() {
 
 let drag = null;
 
+// A press and release without moving (fewer than CLICK_SLOP pixels) is a click: it asks for the map view
+// from the pixel clicked; a larger movement is a drag, which moves the camera.
+const CLICK_SLOP = 3;
+
+function pick(clientX, clientY) {
+  if (!state) return;
+  const r = canvas.getBoundingClientRect();
+  const x = Math.floor((clientX - r.left) / r.width * state.width);
+  const y = Math.floor((clientY - r.top) / r.height * state.height);
+  if (x >= 0 && y >= 0 && x < state.width && y < state.height) send({ type: "pick", x, y });
+}
+
 canvas.addEventListener("pointerdown", (e) => {
-  drag = { x: e.clientX, y: e.clientY, pan: e.button === 2 || e.shiftKey };
+  drag = { x: e.clientX, y: e.clientY, x0: e.clientX, y0: e.clientY, moved: false, button: e.button,
+           pan: e.button === 2 || e.shiftKey };
   if (canvas.setPointerCapture && e.pointerId !== undefined) {
     try { canvas.setPointerCapture(e.pointerId); } catch (_) { /* a synthetic pointer */ }
   }
@@ -185,6 +332,8 @@ canvas.addEventListener("pointerdown", (e) => {
 });
 canvas.addEventListener("pointermove", (e) => {
   if (!drag) return;
+  if (!drag.moved && Math.abs(e.clientX - drag.x0) + Math.abs(e.clientY - drag.y0) < CLICK_SLOP) return;
+  drag.moved = true;
   const h = canvas.clientHeight || 1, w = canvas.clientWidth || 1;
   const dx = e.clientX - drag.x, dy = e.clientY - drag.y;
   drag.x = e.clientX;
@@ -193,7 +342,10 @@ canvas.addEventListener("pointermove", (e) => {
   else queue((p) => { p.orbit[0] += Math.PI * dx / w; p.orbit[1] += Math.PI * dy / h; });
 });
 const endDrag = () => { drag = null; };
-canvas.addEventListener("pointerup", endDrag);
+canvas.addEventListener("pointerup", (e) => {
+  if (drag && !drag.moved && drag.button === 0 && !e.shiftKey) pick(e.clientX, e.clientY);
+  endDrag();
+});
 canvas.addEventListener("pointercancel", endDrag);
 canvas.addEventListener("contextmenu", (e) => e.preventDefault());
 canvas.addEventListener("wheel", (e) => {
@@ -216,6 +368,7 @@ document.addEventListener("keydown", (e) => {
   else if (k === "+" || k === "=") queue((p) => { p.zoom -= 0.1; });
   else if (k === "-" || k === "_") queue((p) => { p.zoom += 0.1; });
   else if (k === "r") send({ type: "reset" });
+  else if (k === "m") { $("mode").value = $("mode").value === "map" ? "image" : "map"; draw(); }
   else return;
   e.preventDefault();
 });
@@ -230,6 +383,9 @@ $("exposure").addEventListener("input", () => {
   draw();
 });
 $("save").addEventListener("click", save);
+$("mode").addEventListener("change", draw);
+$("reference-saved").addEventListener("click", () => send({ type: "reference", source: "saved" }));
+$("reference-none").addEventListener("click", () => send({ type: "reference", source: "none" }));
 for (const id of ["integrator", "shadow_rays", "light_sampler"]) $(id).addEventListener("change", sendOptions);
 
 // ---- self-test (#selftest): what the tests check in a real browser ---------------------------------------
@@ -241,6 +397,15 @@ function waitFrame(test, what, timeoutMs) {
     const f = (h) => { if (test(h)) { clearTimeout(timer); remove(); resolve(h); } };
     const remove = () => { const i = listeners.indexOf(f); if (i >= 0) listeners.splice(i, 1); };
     listeners.push(f);
+  });
+}
+
+function waitMap(what, timeoutMs) {
+  return new Promise((resolve, reject) => {
+    const timer = setTimeout(() => { remove(); reject(new Error("timed out waiting for " + what)); }, timeoutMs);
+    const f = (h) => { clearTimeout(timer); remove(); resolve(h); };
+    const remove = () => { const i = mapListeners.indexOf(f); if (i >= 0) mapListeners.splice(i, 1); };
+    mapListeners.push(f);
   });
 }
 
@@ -277,6 +442,33 @@ async function selftest() {
     const shown = Number(document.querySelector('#stats td[data-key="shadow_rays_skipped"]').dataset.value);
     if (shown !== e.shadow_rays_skipped) throw new Error("the statistics table does not show the frame's numbers");
     log.push(`neepp-adaptive: ${e.shadow_rays_skipped} shadow rays skipped at ${e.spp} spp`);
+    // A click (no movement) shows the map from the point clicked: a heat map of Ṽ over the image, with
+    // values that differ (the room's walls see the clicked point, the corridor behind the door does not).
+    const now = canvas.getBoundingClientRect();
+    const cx = now.left + now.width * 0.4, cy = now.top + now.height * 0.6;
+    const mapped = waitMap("the map view", 15000);
+    fire("pointerdown", cx, cy, 1);
+    fire("pointerup", cx, cy, 0);
+    const m = await mapped;
+    if (!m.hit || !m.map || !m.width) throw new Error("the click gave no map view: " + JSON.stringify(m).slice(0, 300));
+    if ($("mode").value !== "map") throw new Error("the click did not switch to the map view");
+    if (m.view !== frame.header.view || frame.header.coarse) await waitFrame((h) => !h.coarse && h.view === m.view, "a frame to draw the map over", 15000);
+    draw();
+    if (!overlay || overlay.view !== m.view || !(overlay.known > 0) || !(overlay.max > overlay.min))
+      throw new Error("no heat map over the image: " + JSON.stringify(overlay));
+    if (!$("map-summary").textContent.includes("known for")) throw new Error("the map panel says nothing");
+    log.push(`map from cell ${m.cell}: ${overlay.known} pixels, V~ ${overlay.min.toFixed(3)}..${overlay.max.toFixed(3)}, ${m.lights.length} light(s)`);
+    // The relMSE view (the server was started with a reference): the map drawn here averages to the relMSE
+    // the server measured for the frame.
+    $("mode").value = "relmse";
+    $("mode").dispatchEvent(new Event("change"));
+    const f = await waitFrame((h) => !h.coarse && h.relmse !== undefined, "a frame with its relMSE", 15000);
+    draw();
+    if (!overlay || !(Math.abs(overlay.relmse - f.relmse) <= 1e-3 * f.relmse))
+      throw new Error(`the relMSE map averages to ${overlay && overlay.relmse}, the server says ${f.relmse}`);
+    if (document.querySelector('#stats td[data-key="relmse"]').textContent === "–")
+      throw new Error("the statistics do not show the relMSE");
+    log.push(`relMSE ${f.relmse.toExponential(3)} at ${f.spp} spp`);
     out.textContent = "selftest ok: " + log.join("; ");
   } catch (err) {
     out.textContent = "selftest FAILED: " + err.message + " (" + log.join("; ") + ")";
