@@ -54,7 +54,7 @@ struct BinaryReader {
         const uint64_t n = get<uint64_t>();
         if (n > (bytes.size() - pos) / sizeof(T)) throw std::runtime_error(what + ": file is truncated");
         std::vector<T> v(n);
-        std::memcpy(v.data(), bytes.data() + pos, n * sizeof(T));
+        if (n > 0) std::memcpy(v.data(), bytes.data() + pos, n * sizeof(T));  // an empty vector's data() may be null
         pos += n * sizeof(T);
         return v;
     }
