@@ -182,3 +182,49 @@ TEST(SDTree, SavesAndLoadsExactly) {
 }
 
 }  // namespace
+
+namespace {
+
+// Merging what several renders learned: the merged leaf's density at a direction is the energy-weighted
+// mixture of theirs, on the union of their spatial leaves; merging is deterministic and a tree merged
+// with nothing else guides as it did.
+TEST(SDTree, MergeIsTheEnergyWeightedSumOnTheUnionOfLeaves) {
+    const SDTree a = trained(records(7, 30000), 2, small_threshold());
+    SDTreeOptions coarse = small_threshold();
+    coarse.spatial_threshold = 8000;
+    const SDTree b = trained(records(8, 20000), 3, coarse);
+    const SDTree *both[] = {&a, &b};
+    const SDTree merged = SDTree::merge(both);
+    EXPECT_GE(merged.leaf_count(), std::max(a.leaf_count(), b.leaf_count()));
+    EXPECT_EQ(merged.records(), a.records() + b.records());
+    PCG32 rng(3, 9);
+    for (int i = 0; i < 2000; ++i) {
+        const Vec3 p(2 * rng.next_float() - 1, 2 * rng.next_float() - 1, 2 * rng.next_float() - 1);
+        Vec3 d(2 * rng.next_float() - 1, 2 * rng.next_float() - 1, 2 * rng.next_float() - 1);
+        d = d / norm(d);
+        const uint32_t la = a.leaf_at(p), lb = b.leaf_at(p), lm = merged.leaf_at(p);
+        const double ea = a.sampling(la).total(), eb = b.sampling(lb).total();
+        ASSERT_NEAR(merged.sampling(lm).total(), ea + eb, 1e-9 * (ea + eb));
+        const double want = (ea * a.pdf(la, d) + eb * b.pdf(lb, d)) / (ea + eb);
+        ASSERT_NEAR(merged.pdf(lm, d), want, 1e-4 * want + 1e-7) << i;
+    }
+    const SDTree *one[] = {&a};
+    const SDTree alone = SDTree::merge(one);
+    // Alone, the same leaves and densities (its nodes may be numbered otherwise).
+    EXPECT_EQ(alone.leaf_count(), a.leaf_count());
+    for (int i = 0; i < 2000; ++i) {
+        const Vec3 p(2 * rng.next_float() - 1, 2 * rng.next_float() - 1, 2 * rng.next_float() - 1);
+        Vec3 d(2 * rng.next_float() - 1, 2 * rng.next_float() - 1, 2 * rng.next_float() - 1);
+        d = d / norm(d);
+        ASSERT_EQ(alone.pdf(alone.leaf_at(p), d), a.pdf(a.leaf_at(p), d));
+    }
+    EXPECT_TRUE(SDTree::merge(both) == merged);
+    BBox other;
+    other.expand(Vec3(0.f));
+    other.expand(Vec3(5.f));
+    const SDTree c(other);
+    const SDTree *mismatched[] = {&a, &c};
+    EXPECT_THROW(SDTree::merge(mismatched), std::runtime_error);
+}
+
+}  // namespace

@@ -148,4 +148,39 @@ TEST(PathGuiding, SameImageToTheBitForASeedAndThreadCount) {
     EXPECT_FALSE(a.data == c.data) << "another seed";
 }
 
+// The state carries the tree (checkpoints, distributed rounds); merged states hold what each render learned.
+TEST(PathGuiding, StateCarriesAndMergesTheTree) {
+    const std::string path = write_temp_scene(lit_room_xml());
+    auto learn = [&](uint64_t seed, int spp) {
+        auto scene = load_scene(path);
+        auto integrator = make_integrator("path", with_scene_options(*scene, Options(kGuided)));
+        RenderJob job;
+        job.spp = spp;
+        job.seed = seed;
+        render(*scene, *integrator, job);
+        return std::pair{integrator->save_state(), SDTree(*dynamic_cast<const PathIntegrator &>(*integrator).guide())};
+    };
+    const auto [state_a, tree_a] = learn(1, 8);
+    const auto [state_b, tree_b] = learn(2, 16);
+    auto scene = load_scene(path);
+    auto fresh = make_integrator("path", with_scene_options(*scene, Options(kGuided)));
+    fresh->prepare(*scene);
+    fresh->restore_state(*scene, state_a);
+    EXPECT_TRUE(*dynamic_cast<const PathIntegrator &>(*fresh).guide() == tree_a);
+    EXPECT_EQ(fresh->save_state(), state_a);
+
+    const std::string merged = fresh->merge_states(std::string(), {state_a, state_b});
+    fresh->restore_state(*scene, merged);
+    const SDTree *trees[] = {&tree_a, &tree_b};
+    EXPECT_TRUE(*dynamic_cast<const PathIntegrator &>(*fresh).guide() == SDTree::merge(trees));
+    EXPECT_EQ(fresh->merge_states(state_a, {}), state_a);
+    // An unguided state is refused by a guided integrator, not misread.
+    auto plain = make_integrator("path", with_scene_options(*scene, Options(OptionMap{{"shadow_rays", "neepp"}})));
+    plain->prepare(*scene);
+    RenderJob job;
+    job.spp = 2;
+    render(*scene, *plain, job);
+    EXPECT_THROW(fresh->restore_state(*scene, plain->save_state()), std::runtime_error);
+}
+
 }  // namespace

@@ -169,6 +169,50 @@ DirectionalQuadtree DirectionalQuadtree::refined(double threshold, int max_depth
     return out;
 }
 
+DirectionalQuadtree DirectionalQuadtree::sum(std::span<const DirectionalQuadtree *const> trees) {
+    // Each input is, at the output node being built, either at one of its nodes or inside one of its
+    // leaves (node -1), whose energy is split in four at each level further down.
+    struct Source {
+        const DirectionalQuadtree *tree;
+        int node;
+        double energy;
+    };
+    DirectionalQuadtree out;
+    auto build = [&out](auto &&self, uint32_t at, const std::vector<Source> &sources) -> void {
+        for (int q = 0; q < 4; ++q) {
+            std::vector<Source> next;
+            bool split = false;
+            for (const Source &s : sources) {
+                if (s.node < 0) {
+                    next.push_back({s.tree, -1, s.energy / 4});
+                    continue;
+                }
+                const Node &n = s.tree->nodes_[s.node];
+                split |= n.child[q] != 0;
+                next.push_back(n.child[q] ? Source{s.tree, int(n.child[q]), 0.0} : Source{s.tree, -1, n.sum[q]});
+            }
+            if (split) {
+                const uint32_t child = uint32_t(out.nodes_.size());
+                out.nodes_.emplace_back();
+                out.nodes_[at].child[q] = child;
+                self(self, child, next);
+            } else {
+                double e = 0;
+                for (const Source &s : next) e += s.energy;
+                out.nodes_[at].sum[q] = e;
+            }
+        }
+    };
+    std::vector<Source> roots;
+    for (const DirectionalQuadtree *t : trees) roots.push_back({t, 0, 0.0});
+    build(build, 0, roots);
+    // Interior quadrants hold their child's total; children come after their parents.
+    for (size_t i = out.nodes_.size(); i-- > 0;)
+        for (int q = 0; q < 4; ++q)
+            if (out.nodes_[i].child[q]) out.nodes_[i].sum[q] = quadrant_total(out.nodes_[out.nodes_[i].child[q]]);
+    return out;
+}
+
 void DirectionalQuadtree::write(std::string &out) const {
     put(out, uint32_t(nodes_.size()));
     for (const Node &n : nodes_) {

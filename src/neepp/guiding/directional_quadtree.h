@@ -59,6 +59,11 @@ public:
     // energy at all, every quadrant counts 4^-depth (uniform refinement). The result holds no energy.
     DirectionalQuadtree refined(double threshold, int max_depth) const;
 
+    // The sum of several trees' energies, on the union of their cells (a leaf of one inside another's
+    // finer cells counts as spread evenly over them): what recording all their records would have given
+    // on that union. Summed in the order given.
+    static DirectionalQuadtree sum(std::span<const DirectionalQuadtree *const> trees);
+
     // Bytes for checkpoints and merges: topology and energies, exactly.
     void write(std::string &out) const;
     // Reads what write() wrote from data at offset (advanced past it); throws std::runtime_error if malformed.

@@ -102,7 +102,7 @@ void SDTree::update(int pass_spp) {
         count += leaf.count;
     }
     records_ = count;
-    if (energy > 0 && count > 0) scale_exponent_ = std::clamp(24 - std::ilogb(energy / double(count)), -900, 900);
+    set_scale_from_energy();
 
     // Split leaves that saw many records; the halves inherit the trees and half the count each, and split
     // again while that is still over the threshold (as PPG's).
@@ -119,6 +119,56 @@ void SDTree::update(int pass_spp) {
         nodes_.push_back({0, uint32_t(leaves_.size() - 1), axis});
     }
     for (Leaf &leaf : leaves_) start_recording(leaf);
+}
+
+void SDTree::set_scale_from_energy() {
+    double energy = 0;
+    for (const Leaf &leaf : leaves_) energy += leaf.sampling.total();
+    if (energy > 0 && records_ > 0) scale_exponent_ = std::clamp(24 - std::ilogb(energy / double(records_)), -900, 900);
+}
+
+SDTree SDTree::merge(std::span<const SDTree *const> trees) {
+    if (trees.empty()) throw std::invalid_argument("SDTree::merge: no trees");
+    SDTree out;
+    out.options_ = trees[0]->options_;
+    out.lo_ = trees[0]->lo_;
+    out.size_ = trees[0]->size_;
+    for (const SDTree *t : trees) {
+        if (!(t->lo_ == out.lo_) || t->size_ != out.size_) throw std::runtime_error("guide: merging trees of other scenes");
+        out.records_ += t->records_;
+    }
+    // Every tree splits along x, y, z in turn from the same cube, so their nodes line up: walk them
+    // together, each staying at its leaf where it splits no further.
+    out.nodes_.push_back(SpatialNode{});
+    auto build = [&](auto &&self, uint32_t at, const std::vector<uint32_t> &at_nodes) -> void {
+        bool split = false;
+        for (size_t i = 0; i < trees.size(); ++i) split |= trees[i]->nodes_[at_nodes[i]].children != 0;
+        if (!split) {
+            std::vector<const DirectionalQuadtree *> quadtrees;
+            for (size_t i = 0; i < trees.size(); ++i)
+                quadtrees.push_back(&trees[i]->leaves_[trees[i]->nodes_[at_nodes[i]].leaf].sampling);
+            out.nodes_[at].leaf = uint32_t(out.leaves_.size());
+            out.leaves_.emplace_back().sampling = DirectionalQuadtree::sum(quadtrees);
+            return;
+        }
+        const uint32_t first = uint32_t(out.nodes_.size());
+        const uint8_t axis = uint8_t((out.nodes_[at].axis + 1) % 3);
+        out.nodes_[at].children = first;
+        out.nodes_.push_back({0, 0, axis});
+        out.nodes_.push_back({0, 0, axis});
+        for (uint32_t side = 0; side < 2; ++side) {
+            std::vector<uint32_t> below;
+            for (size_t i = 0; i < trees.size(); ++i) {
+                const SpatialNode &n = trees[i]->nodes_[at_nodes[i]];
+                below.push_back(n.children ? n.children + side : at_nodes[i]);
+            }
+            self(self, first + side, below);
+        }
+    };
+    build(build, 0, std::vector<uint32_t>(trees.size(), 0));
+    out.set_scale_from_energy();
+    for (Leaf &leaf : out.leaves_) out.start_recording(leaf);
+    return out;
 }
 
 nlohmann::json SDTree::statistics() const {
@@ -154,6 +204,17 @@ std::string SDTree::save() const {
 }
 
 void SDTree::load(std::string_view bytes) {
+    SDTree t = decode(bytes);
+    if (!(t.lo_ == lo_) || t.size_ != size_) throw std::runtime_error("guide: the SD-tree covers another scene");
+    const SDTreeOptions options = options_;
+    *this = std::move(t);
+    // The recording trees follow this tree's options, not the saved one's defaults.
+    options_ = options;
+    for (Leaf &leaf : leaves_) start_recording(leaf);
+}
+
+SDTree SDTree::decode(std::string_view bytes) {
+    SDTree out;
     size_t offset = 0;
     if (bytes.size() < sizeof kMagic || std::memcmp(bytes.data(), kMagic, sizeof kMagic) != 0)
         throw std::runtime_error("guide: not an SD-tree");
@@ -163,7 +224,7 @@ void SDTree::load(std::string_view bytes) {
     lo.y = get<float>(bytes, offset);
     lo.z = get<float>(bytes, offset);
     const float size = get<float>(bytes, offset);
-    if (!(lo == lo_) || size != size_) throw std::runtime_error("guide: the SD-tree covers another scene");
+    if (!(size > 0) || !std::isfinite(size)) throw std::runtime_error("guide: bad SD-tree cube");
     const int scale = get<int32_t>(bytes, offset);
     const uint64_t records = get<uint64_t>(bytes, offset);
     const uint32_t node_count = get<uint32_t>(bytes, offset);
@@ -185,13 +246,16 @@ void SDTree::load(std::string_view bytes) {
     std::vector<Leaf> leaves(leaf_count);
     for (Leaf &leaf : leaves) {
         leaf.sampling = DirectionalQuadtree::read(bytes, offset);
-        start_recording(leaf);
+        out.start_recording(leaf);
     }
     if (offset != bytes.size()) throw std::runtime_error("guide: trailing bytes after the SD-tree");
-    nodes_ = std::move(nodes);
-    leaves_ = std::move(leaves);
-    scale_exponent_ = scale;
-    records_ = records;
+    out.lo_ = lo;
+    out.size_ = size;
+    out.nodes_ = std::move(nodes);
+    out.leaves_ = std::move(leaves);
+    out.scale_exponent_ = std::clamp(scale, -900, 900);
+    out.records_ = records;
+    return out;
 }
 
 bool SDTree::operator==(const SDTree &o) const {

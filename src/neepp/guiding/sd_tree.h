@@ -11,6 +11,7 @@
 #pragma once
 #include <cstdint>
 #include <memory>
+#include <span>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -56,6 +57,12 @@ public:
     // Exact bytes of the whole tree, between passes (nothing recorded since the last update()).
     std::string save() const;
     void load(std::string_view bytes);  // throws std::runtime_error if malformed or for another scene's cube
+    static SDTree decode(std::string_view bytes);  // a tree from save()'s bytes, whatever its cube
+    // Distributed rendering: the trees that renders of several sample ranges learned (each from the same
+    // start), as one: spatial leaves where any of them has one, each leaf's sampled quadtree the sum of
+    // theirs at it (DirectionalQuadtree::sum), as if one render had recorded what each recorded last.
+    // Deterministic, in the order given; all must cover the same cube.
+    static SDTree merge(std::span<const SDTree *const> trees);
     bool operator==(const SDTree &o) const;
 
 private:
@@ -70,6 +77,8 @@ private:
         uint64_t count = 0;              // records this pass
     };
     void start_recording(Leaf &leaf) const;
+    SDTree() = default;
+    void set_scale_from_energy();
 
     SDTreeOptions options_;
     Vec3 lo_;

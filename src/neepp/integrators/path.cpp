@@ -8,6 +8,7 @@
 #include "neepp/base/bsdf.h"
 #include "neepp/integrators/path_batch.h"
 #include "neepp/integrators/path_guiding.h"
+#include "neepp/integrators/path_state.h"
 #include "neepp/light_selection/factory.h"
 #include "neepp/math/warp.h"
 #include "neepp/sampling/sampler.h"
@@ -66,7 +67,12 @@ void PathIntegrator::end_pass(const Scene &, const PassStatistics &pass) {
 }
 
 void PathIntegrator::restore_state(const Scene &, const std::string &state) {
-    shadow_->restore_state(state);
+    const PathState parts = PathState::decode(state, options_.guiding);
+    shadow_->restore_state(parts.shadow);
+    if (guide_ && guide_learns_ && !parts.guide.empty()) {
+        guide_->load(parts.guide);
+        guide_spp_ = parts.guide_spp;
+    }
     queries_ = &shadow_->query_tester();
     light_sampler_->end_pass();  // its distributions read the restored map
     within_light_.end_pass();

@@ -59,11 +59,10 @@ public:
     bool learns_between_passes() const override {
         return shadow_->learns_between_passes() || (guide_ && guide_learns_);
     }
-    // What the shadow-ray component has learned (NEE++'s map, phase, calibration).
-    std::string save_state() const override { return shadow_->save_state(); }
-    std::string merge_states(const std::string &base, const std::vector<std::string> &learned) const override {
-        return shadow_->merge_states(base, learned);
-    }
+    // What the shadow-ray component has learned (NEE++'s map, phase, calibration), and with guiding the
+    // SD-tree the next pass samples (path_state.cpp).
+    std::string save_state() const override;
+    std::string merge_states(const std::string &base, const std::vector<std::string> &learned) const override;
     void restore_state(const Scene &scene, const std::string &state) override;
     nlohmann::json statistics() const override;
     // The reference form: one path, one vertex at a time, every choice made where it reads (path.cpp).
