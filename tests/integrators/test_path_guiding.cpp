@@ -3,8 +3,11 @@
 // for the scene, which must cost variance only; images the same to the bit for a seed and thread count;
 // the option accepted where it is implemented and refused elsewhere.
 #include <gtest/gtest.h>
+#include <algorithm>
 #include <cmath>
+#include "common/chi2.h"
 #include "neepp/integrators/path.h"
+#include "neepp/integrators/path_guiding.h"
 #include "neepp/io/image.h"
 #include "neepp/sampling/rng.h"
 #include "neepp/scene/scene.h"
@@ -181,6 +184,64 @@ TEST(PathGuiding, StateCarriesAndMergesTheTree) {
     job.spp = 2;
     render(*scene, *plain, job);
     EXPECT_THROW(fresh->restore_state(*scene, plain->save_state()), std::runtime_error);
+}
+
+// The guide's sampling at a vertex against its density, folded onto one side (a surface that only
+// reflects) and not: chi-square on the 128 x 128 grid of the cylindrical mapping around z, whose cells the
+// quadtree's (max_depth 7) and their mirror images across z = 0 align with, so each bin's expected count
+// is its density times its area exactly; the density integrates to one, and is zero behind the surface.
+TEST(PathGuiding, ChiSquareOfTheVertexGuideAgainstItsDensity) {
+    BBox box;
+    box.expand(Vec3(-1.f));
+    box.expand(Vec3(1.f));
+    SDTreeOptions o;
+    o.max_depth = 7;
+    SDTree tree(box, o);
+    PCG32 rng(1, 1);
+    for (int pass = 0; pass < 3; ++pass) {
+        for (int i = 0; i < 30000; ++i) {
+            Vec3 d(2 * rng.next_float() - 1, 2 * rng.next_float() - 1, 2 * rng.next_float() - 1);
+            if (rng.next_float() < 0.6f) d = Vec3(0.3f, -0.2f, -0.8f) + d * 0.2f;  // mostly from below
+            tree.record(Vec3(0.f), d / norm(d), 1.0);
+        }
+        tree.update(1);
+    }
+    for (bool fold : {false, true}) {
+        VertexGuide g;
+        g.tree = &tree;
+        g.leaf = tree.leaf_at(Vec3(0.f));
+        g.bsdf_fraction = 0.5f;
+        g.fold = fold;
+        g.up = Vec3(0, 0, 1);
+        const int n = 128, samples = 1000000;
+        const double two_pi = 6.283185307179586;
+        std::vector<double> observed(size_t(n) * n, 0.0), expected(size_t(n) * n, 0.0);
+        PCG32 r(2, 2);
+        for (int i = 0; i < samples; ++i) {
+            const Vec3 d = g.sample(r.next_2d());
+            if (fold) ASSERT_GE(d.z, 0.f);
+            const double c = std::clamp((double(d.z) + 1) / 2, 0.0, std::nextafter(1.0, 0.0));
+            double phi = std::atan2(double(d.y), double(d.x));
+            if (phi < 0) phi += two_pi;
+            observed[size_t(std::min(phi / two_pi, std::nextafter(1.0, 0.0)) * n) * n + size_t(c * n)] += 1;
+        }
+        double integral = 0, behind = 0;
+        for (int y = 0; y < n; ++y)
+            for (int x = 0; x < n; ++x) {
+                const double phi = two_pi * (y + 0.5) / n, ct = 2 * (x + 0.5) / n - 1, st = std::sqrt(1 - ct * ct);
+                const Vec3 d(float(st * std::cos(phi)), float(st * std::sin(phi)), float(ct));
+                const double mass = double(g.guide_pdf(d)) * 4 * 3.141592653589793 / (double(n) * n);
+                expected[size_t(y) * n + x] = mass * samples;
+                integral += mass;
+                if (ct < 0) behind += mass;
+            }
+        EXPECT_NEAR(integral, 1.0, 1e-5) << fold;
+        if (fold) EXPECT_EQ(behind, 0.0);
+        else EXPECT_GT(behind, 0.3) << "the tree learned light from below";
+        const test::Chi2Result res = test::chi2_from_histograms(observed, expected);
+        EXPECT_TRUE(res.error.empty()) << res.error;
+        EXPECT_GT(res.p_value, 0.01 / 2) << fold << " " << res.describe();
+    }
 }
 
 }  // namespace

@@ -13,6 +13,9 @@ VertexGuide guide_at(SDTree *tree, bool learn, const SurfaceInteraction &si, flo
     if (tree->can_guide(g.leaf)) {
         g.tree = tree;
         g.bsdf_fraction = bsdf_fraction;
+        g.fold = !(flags & BSDFTransmission);
+        const Vec3 n = si.sh_frame.n;
+        g.up = dot(si.to_world(si.wi), n) >= 0 ? n : -n;
     }
     return g;
 }
@@ -28,7 +31,7 @@ BSDFSample sample_guided(const VertexGuide &g, const BSDF &bsdf, const SurfaceIn
         return bs;
     }
     BSDFSample bs;
-    const Vec3 d = g.tree->sample(g.leaf, u2);
+    const Vec3 d = g.sample(u2);
     bs.wo = si.to_local(d);
     const BSDFEval e = bsdf.eval_pdf(BSDFContext{}, si, si.wi, bs.wo);
     // The tree's density of d as pdf() gives it, which is the one the BSDF-sampled branch sees too.

@@ -16,10 +16,28 @@ struct VertexGuide {
     uint32_t leaf = 0;
     float bsdf_fraction = 1.f;
     bool record = false;           // the vertex's sampled direction is recorded into the tree
+    // Where the BSDF only reflects, the guide's directions are folded onto the side it reflects to (that
+    // of `up`, the shading normal turned toward wi): a direction behind the surface is mirrored across
+    // it, so no guided sample is lost to a zero BSDF, and the folded density at d is the tree's at d plus
+    // its at d's mirror image.
+    bool fold = false;
+    Vec3 up;
+    static Vec3 mirror(const Vec3 &d, const Vec3 &n) { return d - n * (2.f * dot(d, n)); }
+    // The guide's own density of direction d.
+    float guide_pdf(const Vec3 &d) const {
+        if (!fold) return tree->pdf(leaf, d);
+        if (!(dot(d, up) > 0)) return 0.f;
+        return tree->pdf(leaf, d) + tree->pdf(leaf, mirror(d, up));
+    }
+    // A direction from the guide alone, with density guide_pdf.
+    Vec3 sample(Vec2 u) const {
+        const Vec3 d = tree->sample(leaf, u);
+        return fold && dot(d, up) < 0 ? mirror(d, up) : d;
+    }
     // The density with which the vertex samples world direction d, the BSDF's own density being bsdf_pdf:
     // what weighs the sample, and what MIS against next event estimation must see as the BSDF strategy's.
     float pdf(const Vec3 &d, float bsdf_pdf) const {
-        return tree ? bsdf_fraction * bsdf_pdf + (1.f - bsdf_fraction) * tree->pdf(leaf, d) : bsdf_pdf;
+        return tree ? bsdf_fraction * bsdf_pdf + (1.f - bsdf_fraction) * guide_pdf(d) : bsdf_pdf;
     }
 };
 
