@@ -136,6 +136,8 @@ def part_lights(a, out: Path, lines: list, results: dict):
     w, h = (int(x) for x in a.res.split("x"))
     runs = {}
     for sampler, policy in SAMPLERS:
+        if a.samplers and sampler != "bvh" and sampler not in a.samplers.split(","):
+            continue
         pair = [runner.run_neepp(xml, d / f"{sampler}_{k}.exr", spp=a.spp, resx=w, resy=h, seed=1 + 1000 * k,
                                  threads=a.threads, integrator_args={"light_sampler": sampler, "shadow_rays": policy},
                                  timeout=7200) for k in range(2)]
@@ -208,6 +210,7 @@ def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--parts", default="lights,mesh,threads")
     ap.add_argument("--lights", type=int, default=10000, help="emissive rectangles (a square number)")
+    ap.add_argument("--samplers", default="", help="only these light samplers (comma-separated; bvh is always run)")
     ap.add_argument("--res", default="160x90")
     ap.add_argument("--spp", type=int, default=16)
     ap.add_argument("--threads", type=int, default=2)

@@ -210,5 +210,54 @@ TEST(LightSelection, VisibilitySamplerFavoursTheLightsTheMapSeesAndFollowsTheMap
     EXPECT_GE(after, 0.1f * p_power * 0.99f) << "the defensive share";
 }
 
+// With more lights than SpatialEstimateOptions::light_samples_per_table / points_per_voxel (256), the
+// spatial estimate takes fewer points per table (one at 4096 lights and beyond): the tables stay exact
+// distributions, sample() and pmf() agree, and every light keeps its defensive share.
+TEST(LightSelection, TablesOverHundredsOfLightsStayExact) {
+    std::string xml = testing::scene_header_xml(3, 70, "0.2,1,0.2", "2,0.8,2", 16, 12) + R"(
+  <bsdf type="diffuse" id="white"><rgb name="reflectance" value="0.6"/></bsdf>
+  <shape type="cube"><transform name="to_world"><scale x="2" y="1" z="2"/><translate x="2" y="1" z="2"/></transform><ref id="white"/></shape>
+  <shape type="cube"><transform name="to_world"><scale x="0.05" y="1" z="1"/><translate x="2" y="1" z="1"/></transform><ref id="white"/></shape>
+)";
+    const int side = 24;  // 576 lights: 7 points per table instead of 16
+    for (int i = 0; i < side; ++i)
+        for (int j = 0; j < side; ++j)
+            xml += "  <shape type=\"rectangle\"><transform name=\"to_world\"><scale x=\"0.04\" y=\"0.04\"/><rotate x=\"1\" angle=\"90\"/>"
+                   "<translate x=\"" + std::to_string(4.f * (i + 0.5f) / side) + "\" y=\"1.98\" z=\"" + std::to_string(4.f * (j + 0.5f) / side) +
+                   "\"/></transform><emitter type=\"area\"><rgb name=\"radiance\" value=\"" + std::to_string(1 + (i * 7 + j * 3) % 11) +
+                   "\"/></emitter></shape>\n";
+    xml += "</scene>\n";
+    auto scene = load_scene(testing::write_temp_scene(xml, "many_lights.xml"));
+    NeeppOptions o;
+    o.policy = ShadowRayPolicy::TraceAll;
+    NeeppShadowRays neepp(o);
+    neepp.prepare(*scene);
+    auto lights = scene->light_pointers();
+    ASSERT_EQ(lights.size(), size_t(side * side));
+    LightSelectionInputs in{scene.get(), neepp.voxel_grid(), neepp.visibility_map(), 16};
+    PCG32 rng(41, 5);
+    for (const char *name : {"spatial", "spatial-oriented", "visibility"}) {
+        auto sampler = make_light_sampler(name, lights, in);
+        for (int c = 0; c < 12; ++c) {
+            const LightSampleContext ctx{Vec3(0.2f + 3.6f * rng.next_float(), 0.1f + 1.7f * rng.next_float(), 0.2f + 3.6f * rng.next_float()),
+                                         Vec3(0.f, 1.f, 0.f)};
+            double sum = 0;
+            float smallest = 1;
+            for (const Light *l : lights) {
+                const float p = sampler->pmf(ctx, *l);
+                sum += p;
+                smallest = std::min(smallest, p);
+            }
+            EXPECT_NEAR(sum, 1.0, 1e-4) << name;
+            EXPECT_GT(smallest, 0.f) << name << ": a light lost its defensive share";
+            for (int k = 0; k < 20; ++k) {
+                const SampledLight s = sampler->sample(ctx, rng.next_float());
+                ASSERT_TRUE(s.light) << name;
+                ASSERT_EQ(s.pmf, sampler->pmf(ctx, *s.light)) << name;
+            }
+        }
+    }
+}
+
 }  // namespace
 }  // namespace neepp

@@ -113,6 +113,14 @@ std::unique_ptr<PathIntegrator> make_path(const Options &options, bool volumetri
     if (form != "fast" && form != "reference")
         throw std::invalid_argument("form must be 'fast' or 'reference', not '" + form + "'");
     o.reference = form == "reference";
+    if (!volumetric) {
+        const std::string guiding = options.get_string("guiding", "none");
+        if (guiding != "none" && guiding != "sdtree")
+            throw std::invalid_argument("guiding must be 'none' or 'sdtree', not '" + guiding + "'");
+        o.guiding = guiding == "sdtree";
+    } else if (options.has("guiding")) {
+        throw std::invalid_argument("volpath: guiding is refused: it is the path integrator's (path -I guiding=sdtree)");
+    }
     const auto &within = WithinLightSampling::names();
     if (std::find(within.begin(), within.end(), o.within_light) == within.end())
         throw std::invalid_argument("within_light must be 'own' or 'visibility', not '" + o.within_light + "'");
@@ -142,6 +150,9 @@ std::unique_ptr<PathIntegrator> make_path(const Options &options, bool volumetri
 // built once here, so that a bad option is reported before the scene loads, and an option counts as
 // unused only if no candidate reads it.
 std::unique_ptr<Integrator> make_auto_path(const Options &options, bool volumetric) {
+    if (options.has("guiding") && options.get_string("guiding", "none") != "none")
+        throw std::invalid_argument("neepp=auto with guiding is refused: its pilot measures candidates without one; "
+                                    "use neepp=off");
     for (const char *key : {"light_sampler", "within_light", "shadow_rays"})
         if (options.has(key))
             throw std::invalid_argument(std::string("neepp=auto chooses light_sampler, within_light and shadow_rays itself: "
@@ -217,6 +228,10 @@ std::unique_ptr<Integrator> make_integrator(const std::string &name, const Optio
         if (options.get_string("shadow_rays", "nee") == "neepp-cv")
             throw std::invalid_argument("pssmlt: shadow_rays=neepp-cv is refused: its estimate can be negative, and "
                                         "a Markov chain needs a target that never is (use neepp or neepp-adaptive)");
+        // Guiding changes what a sample is worth from one pass to the next, as the pool below would.
+        if (options.has("guiding") && options.get_string("guiding", "none") != "none")
+            throw std::invalid_argument("pssmlt: guiding is refused: the guide learns anew every pass, so a sample would "
+                                        "not be a function of the chain's numbers");
         if (o.bidirectional && options.get_string("light_paths", "independent") == "neepp")
             throw std::invalid_argument("pssmlt: light_paths=neepp is refused: its pool of light subpaths is traced anew "
                                         "every pass, so a sample would not be a function of the chain's numbers");

@@ -58,6 +58,11 @@ std::vector<IntegratorDoc> make_docs() {
     path.options.push_back({"form", "fast",
                             "fast (paths in batches, the default) or reference (one path at a time, the estimator's "
                             "definition: the same image in expectation, slower)", ""});
+    path.options.push_back({"guiding", "none",
+                            "none, or sdtree: practical path guiding (Mueller et al. 2017), an SD-tree learned from "
+                            "each pass's paths guides the next direction by one-sample MIS with the BSDF (half each) "
+                            "where the BSDF has no delta part; unbiased whatever it learned; renders with the "
+                            "reference form", ""});
     path.options.push_back({"nee", text(p.nee), "next event estimation (false: BSDF sampling only, the paper's Path)", ""});
     path.options.push_back({"light_sampler", p.light_sampler, "which light NEE samples: " + samplers, ""});
     path.options.push_back({"within_light", p.within_light,
@@ -85,7 +90,8 @@ std::vector<IntegratorDoc> make_docs() {
     volpath.description = "volumetric path tracing through participating media (Mitsuba 3's volpath): null surfaces "
                           "crossed without a bounce, shadow rays through media and null surfaces; the reference form "
                           "only";
-    std::erase_if(volpath.options, [](const OptionDoc &o) { return o.name == "form" || o.name.rfind("ris", 0) == 0; });
+    std::erase_if(volpath.options, [](const OptionDoc &o) { return o.name == "form" || o.name == "guiding" || o.name.rfind("ris", 0) == 0;
+    });
     docs.push_back(volpath);
 
     IntegratorDoc bdpt{"bdpt", "bidirectional path tracing, every (s, t) strategy, MIS-weighted", common(b.max_depth, b.rr_depth, b.hide_emitters)};

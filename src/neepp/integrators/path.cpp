@@ -7,6 +7,8 @@
 
 #include "neepp/base/bsdf.h"
 #include "neepp/integrators/path_batch.h"
+#include "neepp/integrators/path_guiding.h"
+#include "neepp/integrators/path_state.h"
 #include "neepp/light_selection/factory.h"
 #include "neepp/math/warp.h"
 #include "neepp/sampling/sampler.h"
@@ -21,7 +23,7 @@ PathIntegrator::PathIntegrator(PathOptions options, std::unique_ptr<ShadowRayTes
 PathIntegrator::~PathIntegrator() = default;
 
 const RayBatch *PathIntegrator::batch() const {
-    return options_.reference || options_.volumetric ? nullptr : batch_.get();
+    return options_.reference || options_.volumetric || options_.guiding ? nullptr : batch_.get();
 }
 
 void PathIntegrator::prepare(const Scene &scene) {
@@ -42,6 +44,8 @@ void PathIntegrator::prepare(const Scene &scene) {
     within_light_ = WithinLightSampling(options_.within_light, scene, shadow_->voxel_grid(), shadow_->visibility_map(),
                                         options_.area_light_sampling);
     refresh_resampling();
+    if (options_.guiding && guide_learns_) guide_ = std::make_unique<SDTree>(scene.bounds());
+    guide_spp_ = 0;
 }
 
 void PathIntegrator::refresh_resampling() {
@@ -56,10 +60,19 @@ void PathIntegrator::end_pass(const Scene &, const PassStatistics &pass) {
     light_sampler_->end_pass();  // ... and rebuild the light distributions that read it
     within_light_.end_pass();
     refresh_resampling();
+    if (guide_ && guide_learns_) {  // what this pass recorded guides the next
+        guide_->update(pass.spp - guide_spp_);
+        guide_spp_ = pass.spp;
+    }
 }
 
 void PathIntegrator::restore_state(const Scene &, const std::string &state) {
-    shadow_->restore_state(state);
+    const PathState parts = PathState::decode(state, options_.guiding);
+    shadow_->restore_state(parts.shadow);
+    if (guide_ && guide_learns_ && !parts.guide.empty()) {
+        guide_->load(parts.guide);
+        guide_spp_ = parts.guide_spp;
+    }
     queries_ = &shadow_->query_tester();
     light_sampler_->end_pass();  // its distributions read the restored map
     within_light_.end_pass();
@@ -75,6 +88,7 @@ nlohmann::json PathIntegrator::statistics() const {
         out["light_sampler"] = l;
     }
     if (within_light_.any()) out["within_light"] = within_light_.statistics();
+    if (guide_) out["guiding"] = guide_->statistics();
     return out;
 }
 
@@ -90,7 +104,8 @@ nlohmann::json PathIntegrator::describe() const {
             {"ris", options_.ris},
             {"ris_floor", options_.ris_floor},
             {"ris_depth", options_.ris_depth},
-            {"form", options_.reference ? "reference" : "fast"},
+            {"form", options_.reference || options_.guiding ? "reference" : "fast"},
+            {"guiding", options_.guiding ? "sdtree" : "none"},
             {"shadow_rays", shadow_->policy()},
             {"shadow_ray_options", shadow_->describe()}};
 }
@@ -120,7 +135,8 @@ struct PathIntegrator::LightCandidate {
 };
 
 Color PathIntegrator::sample_direct(const Scene &scene, const SurfaceInteraction &si, const LightSampleContext &ctx,
-                                    const Color &beta, int M, Sampler &sampler, RenderCounters &counters) const {
+                                    const Color &beta, int M, Sampler &sampler, RenderCounters &counters,
+                                    const VertexGuide &guide) const {
     const BSDF &bsdf = *si.shape->bsdf;
     // M candidates, each a light chosen by the light sampler and a point on it, by the light's own sampling
     // or within_light's. Without resampling (M = 1) the one candidate is the sample.
@@ -162,7 +178,7 @@ Color PathIntegrator::sample_direct(const Scene &scene, const SurfaceInteraction
     if (is_black(f)) return Color(0.f);
     // MIS against BSDF sampling, by the light strategy's source density (see emission_weight).
     const float light_pdf = y.ds.pdf * y.light.pmf;
-    const float w_mis = y.ds.delta ? 1.f : mis_power(light_pdf, bsdf_pdf);
+    const float w_mis = y.ds.delta ? 1.f : mis_power(light_pdf, guide.pdf(y.ds.d, bsdf_pdf));
     // The shadow-ray component decides whether to trace (NEE++: with probability q, weight 1/q) and traces.
     ShadowQuery q;
     q.ray = y.ds.dist >= kInfinity ? si.spawn_ray(y.ds.d) : si.spawn_ray_to(y.ds.p);
@@ -188,6 +204,7 @@ Color PathIntegrator::Li(const Scene &scene, const Ray &camera_ray, Sampler &sam
     LightSampleContext prev;
     float prev_bsdf_pdf = 1.f;
     bool prev_delta = true;  // the camera counts as a delta vertex: no MIS on directly seen lights
+    GuideRecorder recorder;  // guiding=sdtree: what the path tells the guide
     for (int depth = 0;; ++depth) {
         SurfaceInteraction si;
         const bool hit = scene.intersect(ray, si);
@@ -219,14 +236,17 @@ Color PathIntegrator::Li(const Scene &scene, const Ray &camera_ray, Sampler &sam
 
         // Next event estimation, where the BSDF has a smooth part a light sample can reach.
         const LightSampleContext ctx = light_context(si, ray.d);
+        const VertexGuide guide = guide_at(guide_.get(), guide_learns_, si, PathOptions::kGuidingBsdfFraction);
         if (options_.nee && (si.shape->bsdf_flags & BSDFSmooth))
-            L += sample_direct(scene, si, ctx, beta, candidates_at(depth), sampler, counters);
+            L += sample_direct(scene, si, ctx, beta, candidates_at(depth), sampler, counters, guide);
 
-        // BSDF sampling: the next direction.
+        // The next direction: by the BSDF, or where a guide has learned, by the BSDF or the guide.
         const BSDF &bsdf = *si.shape->bsdf;
+        const float u_choice = guide.tree ? sampler.next_1d() : 0.f;
         const float u1 = sampler.next_1d();
         const Vec2 u2 = sampler.next_2d();
-        const BSDFSample bs = bsdf.sample(BSDFContext{}, si, si.wi, u1, u2);
+        const BSDFSample bs = guide.tree ? sample_guided(guide, bsdf, si, u_choice, u1, u2)
+                                         : bsdf.sample(BSDFContext{}, si, si.wi, u1, u2);
         if (!bs.valid()) break;
         beta *= bs.weight;
         eta *= bs.eta;
@@ -237,7 +257,9 @@ Color PathIntegrator::Li(const Scene &scene, const Ray &camera_ray, Sampler &sam
 
         if (depth + 1 >= options_.rr_depth && !survives_roulette(beta, eta, sampler)) break;
         if (!(max_component(beta) > 0)) break;
+        if (guide.record) recorder.add(si.p, ray.d, bs.pdf, beta, L);
     }
+    if (guide_ && guide_learns_) recorder.commit(*guide_, L);
     return L;
 }
 

@@ -6,6 +6,7 @@
 #include <memory>
 #include "neepp/base/integrator.h"
 #include "neepp/base/light_sampler.h"
+#include "neepp/guiding/sd_tree.h"
 #include "neepp/light_selection/resampling.h"
 #include "neepp/light_selection/within_light_sampling.h"
 #include "neepp/visibility/shadow_ray_tester.h"
@@ -37,9 +38,15 @@ struct PathOptions {
     // path (null, a mask's clear part, a thin dielectric's transmission) crossed without counting a bounce,
     // and shadow rays that pass such surfaces and media with their transmittance. Reference form only.
     bool volumetric = false;
+    // Practical path guiding (guiding=sdtree, path_guiding.h): at vertices without a delta BSDF part the
+    // next direction is drawn by one-sample MIS between the BSDF (this share) and an SD-tree learned from
+    // the passes before; NEE stays for direct light. Rendered by the reference form.
+    bool guiding = false;
+    static constexpr float kGuidingBsdfFraction = 0.5f;  // PPG's
 };
 
 class PathBatch;
+struct VertexGuide;
 
 class PathIntegrator final : public RayIntegrator {
 public:
@@ -47,13 +54,15 @@ public:
     ~PathIntegrator() override;
     void prepare(const Scene &scene) override;
     void end_pass(const Scene &scene, const PassStatistics &pass) override;
-    // While the shadow-ray policy reads or updates its visibility map (which the light sampler may read too).
-    bool learns_between_passes() const override { return shadow_->learns_between_passes(); }
-    // What the shadow-ray component has learned (NEE++'s map, phase, calibration).
-    std::string save_state() const override { return shadow_->save_state(); }
-    std::string merge_states(const std::string &base, const std::vector<std::string> &learned) const override {
-        return shadow_->merge_states(base, learned);
+    // While the shadow-ray policy reads or updates its visibility map (which the light sampler may read too),
+    // or the guide learns.
+    bool learns_between_passes() const override {
+        return shadow_->learns_between_passes() || (guide_ && guide_learns_);
     }
+    // What the shadow-ray component has learned (NEE++'s map, phase, calibration), and with guiding the
+    // SD-tree the next pass samples (path_state.cpp).
+    std::string save_state() const override;
+    std::string merge_states(const std::string &base, const std::vector<std::string> &learned) const override;
     void restore_state(const Scene &scene, const std::string &state) override;
     nlohmann::json statistics() const override;
     // The reference form: one path, one vertex at a time, every choice made where it reads (path.cpp).
@@ -69,6 +78,14 @@ public:
     ShadowRayTester &shadow_rays() { return *shadow_; }
     // The light choice NEE makes (null before prepare()), for tools that show its distribution.
     const LightSampler *light_sampler() const { return light_sampler_.get(); }
+    // guiding=sdtree: the SD-tree the coming pass samples (null before prepare()).
+    const SDTree *guide() const { return guide_.get(); }
+    // For tests: guide by this tree from now on, and never change it (no records, no updates), e.g. a tree
+    // that is deliberately wrong for the scene. prepare() keeps it.
+    void install_guide(std::unique_ptr<SDTree> tree) {
+        guide_ = std::move(tree);
+        guide_learns_ = false;
+    }
 
 private:
     friend class PathBatch;
@@ -83,8 +100,10 @@ private:
     // Next event estimation at a scattering vertex (pbrt-v4's SampleLd): a light sample, or with ris > 1
     // one of M resampled ones, tested by the shadow-ray component; the contribution already multiplied by
     // the path throughput beta, which contribution-aware shadow-ray policies need to see.
+    // With a guide, the BSDF strategy's density in the MIS weight is the guided mixture's.
     Color sample_direct(const Scene &scene, const SurfaceInteraction &si, const LightSampleContext &ctx,
-                        const Color &beta, int M, Sampler &sampler, RenderCounters &counters) const;
+                        const Color &beta, int M, Sampler &sampler, RenderCounters &counters,
+                        const VertexGuide &guide) const;
     // MIS weight for emission found by a BSDF-sampled ray leaving prev (pdf prev_pdf) toward light.
     float emission_weight(const Light &light, const LightSampleContext &prev, const DirectionSample &ds,
                           float prev_pdf) const;
@@ -111,6 +130,9 @@ private:
     std::unique_ptr<PathBatch> batch_;
     WithinLightSampling within_light_;
     ResamplingVisibility resampling_visibility_;
+    std::unique_ptr<SDTree> guide_;  // guiding=sdtree; records from every thread (SDTree::record is thread-safe)
+    bool guide_learns_ = true;
+    int guide_spp_ = 0;              // samples per pixel the guide has seen, for the size of each pass
 };
 
 }  // namespace neepp

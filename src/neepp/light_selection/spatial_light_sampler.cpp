@@ -1,5 +1,7 @@
 #include "neepp/light_selection/spatial_light_sampler.h"
 
+#include <algorithm>
+
 #include "neepp/sampling/rng.h"
 
 namespace neepp {
@@ -27,7 +29,9 @@ void spatial_light_weights(const VoxelGrid &grid, uint32_t voxel, uint32_t bucke
     PCG32 rng(mix_bits(0x5ba71a1ULL ^ voxel), voxel);
     // Points on a jittered 1D sequence of the voxel's volume: stratification across points matters less
     // than keeping the estimate a pure function of the voxel.
-    for (int k = 0; k < options.points_per_voxel; ++k) {
+    const int points = int(std::clamp<size_t>(size_t(options.light_samples_per_table) / std::max<size_t>(n, 1), 1,
+                                              size_t(std::max(options.points_per_voxel, 1))));
+    for (int k = 0; k < points; ++k) {
         const Vec3 p = lo + Vec3(rng.next_float() * size.x, rng.next_float() * size.y, rng.next_float() * size.z);
         for (size_t l = 0; l < n; ++l) {
             Color Le;

@@ -12,6 +12,10 @@ namespace neepp {
 
 struct SpatialEstimateOptions {
     int points_per_voxel = 16;    // stratified points inside the voxel, one light sample each per light
+    // At most about this many light samples per table: with thousands of lights the points are fewer (down
+    // to one), or building a table would cost points × lights samples (with 10^4 lights, 160 000 per
+    // table; tables were then 75 % of a render). From 256 lights down, every table has all its points.
+    int light_samples_per_table = 4096;
     float power_fraction = 0.1f;  // defensive share of power sampling
     bool oriented = false;        // tables per (voxel, receiver orientation bucket), see normal_bucket()
 };

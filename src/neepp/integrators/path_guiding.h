@@ -1,0 +1,74 @@
+// Practical path guiding (Müller et al. 2017) at a scattering vertex of the path integrator's reference
+// form: the next direction drawn by one-sample MIS between the BSDF (probability bsdf_fraction) and the
+// SD-tree's leaf, weighted by the mixture's density. The BSDF's share is never zero, so every direction
+// the BSDF can reach stays reachable whatever the tree says: the estimate is unbiased for any tree, a
+// wrong one only costs variance. Vertices whose BSDF has a delta part are left to the BSDF.
+#pragma once
+#include <array>
+#include "neepp/base/bsdf.h"
+#include "neepp/base/interaction.h"
+#include "neepp/guiding/sd_tree.h"
+
+namespace neepp {
+
+struct VertexGuide {
+    const SDTree *tree = nullptr;  // null: the BSDF samples alone
+    uint32_t leaf = 0;
+    float bsdf_fraction = 1.f;
+    bool record = false;           // the vertex's sampled direction is recorded into the tree
+    // Where the BSDF only reflects, the guide's directions are folded onto the side it reflects to (that
+    // of `up`, the shading normal turned toward wi): a direction behind the surface is mirrored across
+    // it, so no guided sample is lost to a zero BSDF, and the folded density at d is the tree's at d plus
+    // its at d's mirror image.
+    bool fold = false;
+    Vec3 up;
+    static Vec3 mirror(const Vec3 &d, const Vec3 &n) { return d - n * (2.f * dot(d, n)); }
+    // The guide's own density of direction d.
+    float guide_pdf(const Vec3 &d) const {
+        if (!fold) return tree->pdf(leaf, d);
+        if (!(dot(d, up) > 0)) return 0.f;
+        return tree->pdf(leaf, d) + tree->pdf(leaf, mirror(d, up));
+    }
+    // A direction from the guide alone, with density guide_pdf.
+    Vec3 sample(Vec2 u) const {
+        const Vec3 d = tree->sample(leaf, u);
+        return fold && dot(d, up) < 0 ? mirror(d, up) : d;
+    }
+    // The density with which the vertex samples world direction d, the BSDF's own density being bsdf_pdf:
+    // what weighs the sample, and what MIS against next event estimation must see as the BSDF strategy's.
+    float pdf(const Vec3 &d, float bsdf_pdf) const {
+        return tree ? bsdf_fraction * bsdf_pdf + (1.f - bsdf_fraction) * guide_pdf(d) : bsdf_pdf;
+    }
+};
+
+// The guide at a vertex (tree may be null: no guiding). learn: record into the tree.
+VertexGuide guide_at(SDTree *tree, bool learn, const SurfaceInteraction &si, float bsdf_fraction);
+
+// The next direction by one-sample MIS: u_choice picks the strategy, (u1, u2) drive it. The sample's pdf
+// is the mixture's and its weight f·|cos| / pdf. A direction drawn from the tree carries eta 1 (its only
+// reader is Russian roulette, which any value keeps unbiased).
+BSDFSample sample_guided(const VertexGuide &g, const BSDF &bsdf, const SurfaceInteraction &si, float u_choice, float u1,
+                         Vec2 u2);
+
+// The guided vertices of one path, each with what the path had gathered and its throughput when the
+// vertex's direction was chosen: what the path gathers later, divided by that throughput, is the radiance
+// that arrived along the direction, and that over the direction's density is PPG's record.
+class GuideRecorder {
+public:
+    void add(const Vec3 &p, const Vec3 &d, float pdf, const Color &beta, const Color &L) {
+        if (n_ < int(v_.size())) v_[n_++] = {p, d, pdf, beta, L};
+    }
+    // Records every vertex into the tree, L being all the path gathered.
+    void commit(SDTree &tree, const Color &L) const;
+
+private:
+    struct Vertex {
+        Vec3 p, d;
+        float pdf;
+        Color beta, L;
+    };
+    std::array<Vertex, 64> v_;  // longer paths record their first 64 vertices
+    int n_ = 0;
+};
+
+}  // namespace neepp

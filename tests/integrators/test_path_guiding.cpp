@@ -1,0 +1,247 @@
+// Practical path guiding in the path integrator (guiding=sdtree): the guided image against plain NEE's
+// (per-block z-tests), with the guide learning as it renders and with guides that are deliberately wrong
+// for the scene, which must cost variance only; images the same to the bit for a seed and thread count;
+// the option accepted where it is implemented and refused elsewhere.
+#include <gtest/gtest.h>
+#include <algorithm>
+#include <cmath>
+#include "common/chi2.h"
+#include "neepp/integrators/path.h"
+#include "neepp/integrators/path_guiding.h"
+#include "neepp/io/image.h"
+#include "neepp/sampling/rng.h"
+#include "neepp/scene/scene.h"
+#include "test_scenes.h"
+
+using namespace neepp;
+using namespace neepp::testing;
+
+namespace {
+
+// A room open at the front onto a constant sky, lit also by an area light behind an occluder, with
+// diffuse, glossy and specular surfaces: light arrives mostly indirectly, which is what a guide learns.
+std::string lit_room_xml() {
+    return scene_header_xml(8, 60, "0,1,3.5", "0,0.8,0", 24, 18) + R"(
+  <bsdf type="twosided" id="white"><bsdf type="diffuse"><rgb name="reflectance" value="0.7"/></bsdf></bsdf>
+  <shape type="rectangle"><transform name="to_world"><scale value="2"/><rotate x="1" angle="-90"/></transform><ref id="white"/></shape>
+  <shape type="rectangle"><transform name="to_world"><scale value="2"/><translate z="-2"/></transform>
+    <bsdf type="roughplastic"><float name="alpha" value="0.3"/><rgb name="diffuse_reflectance" value="0.5,0.6,0.4"/></bsdf></shape>
+  <shape type="rectangle"><transform name="to_world"><scale value="2"/><rotate x="1" angle="90"/><translate y="2"/></transform><ref id="white"/></shape>
+  <shape type="sphere"><point name="center" x="0.6" y="0.5" z="0.3"/><float name="radius" value="0.4"/><bsdf type="dielectric"/></shape>
+  <shape type="cube"><transform name="to_world"><scale value="0.4"/><translate x="-0.5" y="0.4" z="-0.3"/></transform>
+    <bsdf type="roughconductor"><string name="material" value="Au"/><float name="alpha" value="0.2"/></bsdf></shape>
+  <shape type="rectangle"><transform name="to_world"><scale value="0.3"/><rotate x="1" angle="90"/><translate y="1.9" z="-1.5"/></transform>
+    <emitter type="area"><rgb name="radiance" value="20"/></emitter></shape>
+  <shape type="rectangle"><transform name="to_world"><scale value="0.6"/><rotate x="1" angle="90"/><translate y="1.6" z="-1.4"/></transform><ref id="white"/></shape>
+  <emitter type="constant"><rgb name="radiance" value="0.5"/></emitter>
+</scene>)";
+}
+
+const OptionMap kGuided = {{"guiding", "sdtree"}};
+
+TEST(PathGuiding, OptionIsPathsAndRefusedElsewhere) {
+    auto guided = make_integrator("path", Options(kGuided));
+    EXPECT_EQ(guided->describe()["guiding"], "sdtree");
+    EXPECT_EQ(guided->describe()["form"], "reference") << "guiding renders with the reference form";
+    EXPECT_EQ(dynamic_cast<RayIntegrator &>(*guided).batch(), nullptr);
+    EXPECT_EQ(make_integrator("path", Options())->describe()["guiding"], "none");
+    EXPECT_NE(dynamic_cast<RayIntegrator &>(*make_integrator("path", Options(OptionMap{{"guiding", "none"}}))).batch(), nullptr);
+    EXPECT_THROW(make_integrator("path", Options(OptionMap{{"guiding", "ppg"}})), std::invalid_argument);
+    for (const char *other : {"volpath", "bdpt", "light", "pssmlt"})
+        EXPECT_THROW(make_integrator(other, Options(kGuided)), std::invalid_argument) << other;
+    EXPECT_THROW(make_integrator("pssmlt", Options(OptionMap{{"guiding", "sdtree"}, {"bidirectional", "false"}})),
+                 std::invalid_argument);
+    EXPECT_THROW(make_integrator("path", Options(OptionMap{{"guiding", "sdtree"}, {"neepp", "auto"}})), std::invalid_argument);
+}
+
+TEST(PathGuiding, GuideLearnsFromThePasses) {
+    auto scene = load_scene(write_temp_scene(lit_room_xml()));
+    auto integrator = make_integrator("path", with_scene_options(*scene, Options(kGuided)));
+    RenderJob job;
+    job.spp = 16;
+    job.seed = 3;
+    render(*scene, *integrator, job);
+    const SDTree *guide = dynamic_cast<const PathIntegrator &>(*integrator).guide();
+    ASSERT_NE(guide, nullptr);
+    EXPECT_TRUE(guide->can_guide(guide->leaf_at(Vec3(0.f, 0.5f, 0.f))));
+    EXPECT_GT(guide->records(), 1000u);
+    EXPECT_GT(guide->sampling(0).leaf_count(), 4u) << "refined by what it recorded";
+    EXPECT_TRUE(integrator->statistics().contains("guiding"));
+}
+
+// Block moments of the guided integrator; `guide` (when given) is installed before each render and kept.
+BlockMoments guided_moments(const std::string &path, const OptionMap &o, int seeds, int spp, uint64_t seed0,
+                            const SDTree *guide) {
+    std::vector<std::vector<double>> per_seed;
+    for (int s = 0; s < seeds; ++s) {
+        auto scene = load_scene(path);
+        auto integrator = make_integrator("path", with_scene_options(*scene, Options(o)));
+        if (guide) dynamic_cast<PathIntegrator &>(*integrator).install_guide(std::make_unique<SDTree>(*guide));
+        RenderJob job;
+        job.spp = spp;
+        job.seed = seed0 + 31 * s;
+        per_seed.push_back(block_means(render(*scene, *integrator, job).image, 6, 6));
+    }
+    return moments_over_seeds(per_seed);
+}
+
+TEST(PathGuiding, UnbiasedAgainstPlainNee) {
+    const std::vector<std::pair<std::string, std::string>> scenes = {{"lit room", lit_room_xml()},
+                                                                      {"glossy room", kGlossyRoomXml}};
+    for (const auto &[name, xml] : scenes) {
+        const std::string path = write_temp_scene(xml);
+        const BlockMoments nee = block_moments(path, "path", Options(), 6, 64, 101);
+        expect_same_image(nee, guided_moments(path, kGuided, 6, 64, 202, nullptr), name + " guided");
+        OptionMap bsdf_only = kGuided;
+        bsdf_only["nee"] = "false";
+        expect_same_image(nee, guided_moments(path, bsdf_only, 6, 64, 303, nullptr), name + " guided, nee=false");
+    }
+}
+
+// A tree that sends nearly every guided direction into a narrow cone around `lobe`, wherever the point.
+SDTree cone_guide(const BBox &bounds, const Vec3 &lobe) {
+    SDTree t(bounds);
+    PCG32 rng(5, 5);
+    for (int pass = 0; pass < 3; ++pass) {
+        for (int i = 0; i < 20000; ++i) {
+            const Vec3 p = bounds.lo + bounds.extent() * Vec3(rng.next_float(), rng.next_float(), rng.next_float());
+            Vec3 d = lobe + Vec3(rng.next_float() - 0.5f, rng.next_float() - 0.5f, rng.next_float() - 0.5f) * 0.05f;
+            t.record(p, d / norm(d), 1.0);
+        }
+        t.update(1);
+    }
+    return t;
+}
+
+TEST(PathGuiding, UnbiasedWithAWrongGuide) {
+    const std::string path = write_temp_scene(lit_room_xml());
+    auto scene = load_scene(path);
+    const BlockMoments nee = block_moments(path, "path", Options(), 6, 64, 101);
+    // Into the floor (the guide's share of the samples is then mostly wasted), and away from the light.
+    const SDTree down = cone_guide(scene->bounds(), Vec3(0, -1, 0));
+    ASSERT_TRUE(down.can_guide(down.leaf_at(Vec3(0.f, 1.f, 0.f))));
+    ASSERT_LT(down.pdf(down.leaf_at(Vec3(0.f, 1.f, 0.f)), Vec3(0, 1, 0)), 1e-3f) << "nothing guided upward";
+    expect_same_image(nee, guided_moments(path, kGuided, 6, 64, 404, &down), "guide pointing down");
+    const SDTree back = cone_guide(scene->bounds(), Vec3(0, 0, 1));
+    expect_same_image(nee, guided_moments(path, kGuided, 6, 64, 505, &back), "guide pointing out of the room");
+    // A guide learned on another scene (its cube elsewhere: points map to its nearest leaves).
+    auto other_scene = load_scene(write_temp_scene(kGlossyRoomXml));
+    auto other = make_integrator("path", with_scene_options(*other_scene, Options(kGuided)));
+    RenderJob job;
+    job.spp = 16;
+    render(*other_scene, *other, job);
+    const SDTree learned_elsewhere = *dynamic_cast<const PathIntegrator &>(*other).guide();
+    expect_same_image(nee, guided_moments(path, kGuided, 6, 64, 606, &learned_elsewhere), "guide of another scene");
+}
+
+TEST(PathGuiding, SameImageToTheBitForASeedAndThreadCount) {
+    const std::string path = write_temp_scene(lit_room_xml());
+    auto render_once = [&](uint64_t seed) {
+        auto scene = load_scene(path);
+        auto integrator = make_integrator("path", with_scene_options(*scene, Options(kGuided)));
+        RenderJob job;
+        job.spp = 24;
+        job.seed = seed;
+        job.threads = 4;
+        return render(*scene, *integrator, job).image;
+    };
+    const Image a = render_once(9), b = render_once(9), c = render_once(10);
+    ASSERT_EQ(a.data.size(), b.data.size());
+    EXPECT_TRUE(a.data == b.data) << "the same seed and thread count";
+    EXPECT_FALSE(a.data == c.data) << "another seed";
+}
+
+// The state carries the tree (checkpoints, distributed rounds); merged states hold what each render learned.
+TEST(PathGuiding, StateCarriesAndMergesTheTree) {
+    const std::string path = write_temp_scene(lit_room_xml());
+    auto learn = [&](uint64_t seed, int spp) {
+        auto scene = load_scene(path);
+        auto integrator = make_integrator("path", with_scene_options(*scene, Options(kGuided)));
+        RenderJob job;
+        job.spp = spp;
+        job.seed = seed;
+        render(*scene, *integrator, job);
+        return std::pair{integrator->save_state(), SDTree(*dynamic_cast<const PathIntegrator &>(*integrator).guide())};
+    };
+    const auto [state_a, tree_a] = learn(1, 8);
+    const auto [state_b, tree_b] = learn(2, 16);
+    auto scene = load_scene(path);
+    auto fresh = make_integrator("path", with_scene_options(*scene, Options(kGuided)));
+    fresh->prepare(*scene);
+    fresh->restore_state(*scene, state_a);
+    EXPECT_TRUE(*dynamic_cast<const PathIntegrator &>(*fresh).guide() == tree_a);
+    EXPECT_EQ(fresh->save_state(), state_a);
+
+    const std::string merged = fresh->merge_states(std::string(), {state_a, state_b});
+    fresh->restore_state(*scene, merged);
+    const SDTree *trees[] = {&tree_a, &tree_b};
+    EXPECT_TRUE(*dynamic_cast<const PathIntegrator &>(*fresh).guide() == SDTree::merge(trees));
+    EXPECT_EQ(fresh->merge_states(state_a, {}), state_a);
+    // An unguided state is refused by a guided integrator, not misread.
+    auto plain = make_integrator("path", with_scene_options(*scene, Options(OptionMap{{"shadow_rays", "neepp"}})));
+    plain->prepare(*scene);
+    RenderJob job;
+    job.spp = 2;
+    render(*scene, *plain, job);
+    EXPECT_THROW(fresh->restore_state(*scene, plain->save_state()), std::runtime_error);
+}
+
+// The guide's sampling at a vertex against its density, folded onto one side (a surface that only
+// reflects) and not: chi-square on the 128 x 128 grid of the cylindrical mapping around z, whose cells the
+// quadtree's (max_depth 7) and their mirror images across z = 0 align with, so each bin's expected count
+// is its density times its area exactly; the density integrates to one, and is zero behind the surface.
+TEST(PathGuiding, ChiSquareOfTheVertexGuideAgainstItsDensity) {
+    BBox box;
+    box.expand(Vec3(-1.f));
+    box.expand(Vec3(1.f));
+    SDTreeOptions o;
+    o.max_depth = 7;
+    SDTree tree(box, o);
+    PCG32 rng(1, 1);
+    for (int pass = 0; pass < 3; ++pass) {
+        for (int i = 0; i < 30000; ++i) {
+            Vec3 d(2 * rng.next_float() - 1, 2 * rng.next_float() - 1, 2 * rng.next_float() - 1);
+            if (rng.next_float() < 0.6f) d = Vec3(0.3f, -0.2f, -0.8f) + d * 0.2f;  // mostly from below
+            tree.record(Vec3(0.f), d / norm(d), 1.0);
+        }
+        tree.update(1);
+    }
+    for (bool fold : {false, true}) {
+        VertexGuide g;
+        g.tree = &tree;
+        g.leaf = tree.leaf_at(Vec3(0.f));
+        g.bsdf_fraction = 0.5f;
+        g.fold = fold;
+        g.up = Vec3(0, 0, 1);
+        const int n = 128, samples = 1000000;
+        const double two_pi = 6.283185307179586;
+        std::vector<double> observed(size_t(n) * n, 0.0), expected(size_t(n) * n, 0.0);
+        PCG32 r(2, 2);
+        for (int i = 0; i < samples; ++i) {
+            const Vec3 d = g.sample(r.next_2d());
+            if (fold) ASSERT_GE(d.z, 0.f);
+            const double c = std::clamp((double(d.z) + 1) / 2, 0.0, std::nextafter(1.0, 0.0));
+            double phi = std::atan2(double(d.y), double(d.x));
+            if (phi < 0) phi += two_pi;
+            observed[size_t(std::min(phi / two_pi, std::nextafter(1.0, 0.0)) * n) * n + size_t(c * n)] += 1;
+        }
+        double integral = 0, behind = 0;
+        for (int y = 0; y < n; ++y)
+            for (int x = 0; x < n; ++x) {
+                const double phi = two_pi * (y + 0.5) / n, ct = 2 * (x + 0.5) / n - 1, st = std::sqrt(1 - ct * ct);
+                const Vec3 d(float(st * std::cos(phi)), float(st * std::sin(phi)), float(ct));
+                const double mass = double(g.guide_pdf(d)) * 4 * 3.141592653589793 / (double(n) * n);
+                expected[size_t(y) * n + x] = mass * samples;
+                integral += mass;
+                if (ct < 0) behind += mass;
+            }
+        EXPECT_NEAR(integral, 1.0, 1e-5) << fold;
+        if (fold) EXPECT_EQ(behind, 0.0);
+        else EXPECT_GT(behind, 0.3) << "the tree learned light from below";
+        const test::Chi2Result res = test::chi2_from_histograms(observed, expected);
+        EXPECT_TRUE(res.error.empty()) << res.error;
+        EXPECT_GT(res.p_value, 0.01 / 2) << fold << " " << res.describe();
+    }
+}
+
+}  // namespace
