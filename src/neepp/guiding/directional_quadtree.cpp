@@ -1,4 +1,5 @@
 #include "neepp/guiding/directional_quadtree.h"
+#include "neepp/io/binary_io.h"
 
 #include <cmath>
 #include <cstring>
@@ -25,14 +26,6 @@ int choose(double share, double &u) {
 
 double below_one(double u) { return std::min(u, std::nextafter(1.0, 0.0)); }
 
-template <typename T> void put(std::string &out, const T &v) { out.append(reinterpret_cast<const char *>(&v), sizeof v); }
-template <typename T> T get(std::string_view data, size_t &offset) {
-    if (offset + sizeof(T) > data.size()) throw std::runtime_error("guide: truncated directional quadtree");
-    T v;
-    std::memcpy(&v, data.data() + offset, sizeof v);
-    offset += sizeof v;
-    return v;
-}
 }  // namespace
 
 Vec3 square_to_direction(double u, double v) {
@@ -214,30 +207,34 @@ DirectionalQuadtree DirectionalQuadtree::sum(std::span<const DirectionalQuadtree
 }
 
 void DirectionalQuadtree::write(std::string &out) const {
-    put(out, uint32_t(nodes_.size()));
+    BinaryWriter w{std::move(out)};
+    w.put(uint32_t(nodes_.size()));
     for (const Node &n : nodes_) {
-        for (uint32_t c : n.child) put(out, c);
-        for (double s : n.sum) put(out, s);
+        for (uint32_t c : n.child) w.put(c);
+        for (double s : n.sum) w.put(s);
     }
+    out = std::move(w.bytes);
 }
 
 DirectionalQuadtree DirectionalQuadtree::read(std::string_view data, size_t &offset) {
-    const uint32_t count = get<uint32_t>(data, offset);
-    if (count < 1 || count > (data.size() - offset) / (4 * (sizeof(uint32_t) + sizeof(double))))
+    BinaryReader r{data, offset, "guide: directional quadtree"};
+    const uint32_t count = r.get<uint32_t>();
+    if (count < 1 || count > (data.size() - r.pos) / (4 * (sizeof(uint32_t) + sizeof(double))))
         throw std::runtime_error("guide: bad directional quadtree size");
     DirectionalQuadtree t;
     t.nodes_.resize(count);
     for (uint32_t i = 0; i < count; ++i) {
         Node &n = t.nodes_[i];
         for (uint32_t &c : n.child) {
-            c = get<uint32_t>(data, offset);
+            c = r.get<uint32_t>();
             if (c != 0 && (c <= i || c >= count)) throw std::runtime_error("guide: bad directional quadtree child");
         }
         for (double &s : n.sum) {
-            s = get<double>(data, offset);
+            s = r.get<double>();
             if (!(s >= 0) || !std::isfinite(s)) throw std::runtime_error("guide: bad directional quadtree energy");
         }
     }
+    offset = r.pos;
     return t;
 }
 

@@ -1,4 +1,5 @@
 #include "neepp/guiding/sd_tree.h"
+#include "neepp/io/binary_io.h"
 
 #include <atomic>
 #include <cmath>
@@ -13,14 +14,6 @@ constexpr uint64_t kMaxRecord = uint64_t(1) << 40;    // one record: 2^16 times 
 constexpr uint64_t kSaturation = uint64_t(1) << 62;   // a slot's sum stops here rather than wrap
 constexpr char kMagic[8] = {'N', 'E', 'E', 'P', 'P', 'S', 'D', '1'};
 
-template <typename T> void put(std::string &out, const T &v) { out.append(reinterpret_cast<const char *>(&v), sizeof v); }
-template <typename T> T get(std::string_view data, size_t &offset) {
-    if (offset + sizeof(T) > data.size()) throw std::runtime_error("guide: truncated SD-tree");
-    T v;
-    std::memcpy(&v, data.data() + offset, sizeof v);
-    offset += sizeof v;
-    return v;
-}
 
 // min(sum + n, kSaturation), whichever order the additions come in (min(min(a + b, S) + c, S) = min(a + b + c, S)
 // for non-negative terms): so a saturated slot is as reproducible as any other.
@@ -185,22 +178,22 @@ nlohmann::json SDTree::statistics() const {
 }
 
 std::string SDTree::save() const {
-    std::string out(kMagic, sizeof kMagic);
-    put(out, lo_.x);
-    put(out, lo_.y);
-    put(out, lo_.z);
-    put(out, size_);
-    put(out, int32_t(scale_exponent_));
-    put(out, uint64_t(records_));
-    put(out, uint32_t(nodes_.size()));
+    BinaryWriter w{std::string(kMagic, sizeof kMagic)};
+    w.put(lo_.x);
+    w.put(lo_.y);
+    w.put(lo_.z);
+    w.put(size_);
+    w.put(int32_t(scale_exponent_));
+    w.put(uint64_t(records_));
+    w.put(uint32_t(nodes_.size()));
     for (const SpatialNode &n : nodes_) {
-        put(out, n.children);
-        put(out, n.leaf);
-        put(out, n.axis);
+        w.put(n.children);
+        w.put(n.leaf);
+        w.put(n.axis);
     }
-    put(out, uint32_t(leaves_.size()));
-    for (const Leaf &leaf : leaves_) leaf.sampling.write(out);
-    return out;
+    w.put(uint32_t(leaves_.size()));
+    for (const Leaf &leaf : leaves_) leaf.sampling.write(w.bytes);
+    return std::move(w.bytes);
 }
 
 void SDTree::load(std::string_view bytes) {
@@ -215,27 +208,26 @@ void SDTree::load(std::string_view bytes) {
 
 SDTree SDTree::decode(std::string_view bytes) {
     SDTree out;
-    size_t offset = 0;
     if (bytes.size() < sizeof kMagic || std::memcmp(bytes.data(), kMagic, sizeof kMagic) != 0)
         throw std::runtime_error("guide: not an SD-tree");
-    offset = sizeof kMagic;
+    BinaryReader r{bytes, sizeof kMagic, "guide: SD-tree"};
     Vec3 lo;
-    lo.x = get<float>(bytes, offset);
-    lo.y = get<float>(bytes, offset);
-    lo.z = get<float>(bytes, offset);
-    const float size = get<float>(bytes, offset);
+    lo.x = r.get<float>();
+    lo.y = r.get<float>();
+    lo.z = r.get<float>();
+    const float size = r.get<float>();
     if (!(size > 0) || !std::isfinite(size)) throw std::runtime_error("guide: bad SD-tree cube");
-    const int scale = get<int32_t>(bytes, offset);
-    const uint64_t records = get<uint64_t>(bytes, offset);
-    const uint32_t node_count = get<uint32_t>(bytes, offset);
+    const int scale = r.get<int32_t>();
+    const uint64_t records = r.get<uint64_t>();
+    const uint32_t node_count = r.get<uint32_t>();
     if (node_count < 1 || node_count > bytes.size()) throw std::runtime_error("guide: bad SD-tree size");
     std::vector<SpatialNode> nodes(node_count);
     for (SpatialNode &n : nodes) {
-        n.children = get<uint32_t>(bytes, offset);
-        n.leaf = get<uint32_t>(bytes, offset);
-        n.axis = get<uint8_t>(bytes, offset);
+        n.children = r.get<uint32_t>();
+        n.leaf = r.get<uint32_t>();
+        n.axis = r.get<uint8_t>();
     }
-    const uint32_t leaf_count = get<uint32_t>(bytes, offset);
+    const uint32_t leaf_count = r.get<uint32_t>();
     if (leaf_count < 1 || leaf_count > bytes.size()) throw std::runtime_error("guide: bad SD-tree size");
     for (size_t i = 0; i < nodes.size(); ++i) {
         const SpatialNode &n = nodes[i];
@@ -245,10 +237,10 @@ SDTree SDTree::decode(std::string_view bytes) {
     }
     std::vector<Leaf> leaves(leaf_count);
     for (Leaf &leaf : leaves) {
-        leaf.sampling = DirectionalQuadtree::read(bytes, offset);
+        leaf.sampling = DirectionalQuadtree::read(bytes, r.pos);
         out.start_recording(leaf);
     }
-    if (offset != bytes.size()) throw std::runtime_error("guide: trailing bytes after the SD-tree");
+    if (r.pos != bytes.size()) throw std::runtime_error("guide: trailing bytes after the SD-tree");
     out.lo_ = lo;
     out.size_ = size;
     out.nodes_ = std::move(nodes);

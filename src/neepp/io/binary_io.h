@@ -6,6 +6,7 @@
 #include <iterator>
 #include <stdexcept>
 #include <string>
+#include <string_view>
 #include <type_traits>
 #include <vector>
 
@@ -39,7 +40,7 @@ struct BinaryWriter {
 };
 
 struct BinaryReader {
-    const std::string &bytes;
+    std::string_view bytes;
     size_t pos = 0;
     std::string what;  // prefix of errors, e.g. "visibility map 'a.map'"
     template <typename T> T get() {
@@ -61,7 +62,7 @@ struct BinaryReader {
     std::string get_string() {
         const uint64_t n = get<uint64_t>();
         need(n);
-        std::string s = bytes.substr(pos, n);
+        std::string s(bytes.substr(pos, n));
         pos += n;
         return s;
     }
