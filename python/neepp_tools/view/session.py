@@ -4,12 +4,14 @@ One session per server, shared by every page open on it: the camera, the integra
 Each change (a camera move, an option) cancels the render under way at once (LiveRender.cancel) and a
 thread of the session's own renders the new view: first a coarse image (a quarter of the resolution, one
 sample per pixel), then the full image, sent after each pass (a few times a second) as it converges, up to
-the most samples per pixel a view gets. The integrator is kept across camera moves, so NEE++'s visibility
-map, which belongs to the scene and not to the view, keeps learning from every view; a new integrator or
-new options start it afresh.
+the most samples per pixel a view gets. Within a pass, once a first is complete, the image is sent too
+(the completed passes with the tiles of the running pass that are finished), so that it moves on about ten
+times a second however long a pass of the scene takes. The integrator is kept across camera moves, so
+NEE++'s visibility map, which belongs to the scene and not to the view, keeps learning from every view; a
+new integrator or new options start it afresh.
 
-What the integrator learned is read by the render thread alone, between passes (from a frame's callback)
-or between renders: a page's question about the map (a clicked point) is queued for it and answered
+What the integrator learned is read by the render thread alone, between passes (from the callback of a
+frame between passes, not of one within a pass) or between renders: a page's question about the map (a clicked point) is queued for it and answered
 through a future, so that no pass ever runs while the map is read.
 """
 from __future__ import annotations
@@ -276,12 +278,15 @@ class ViewSession:
         self.on_message(self.state())
 
     def _frame(self, view: int, camera: dict, image: np.ndarray, info: dict, coarse: bool) -> None:
-        self._answer_requests()  # between passes: the map holds still
+        if not info["within_pass"]:
+            self._answer_requests()  # between passes: the map holds still (within one it is learning)
         if not self._current(view):  # a cancelled render's last image: of a view no longer shown
             return
         t = info["render_time_s"]
+        # Within a pass the tiles it finished have more samples than the others: spp is the fewest a pixel
+        # has, spp_max the most, spp_mean their mean (the samples in the image).
         stats = {**info, "view": view, "coarse": coarse, "integrator": self.integrator, "options": self.options(),
-                 "samples_per_s": info["spp"] * info["width"] * info["height"] / t if t > 0 else 0.0, **camera}
+                 "samples_per_s": info["spp_mean"] * info["width"] * info["height"] / t if t > 0 else 0.0, **camera}
         reference = self.reference
         if not coarse and reference is not None and reference.shape == image.shape:
             # neepp compare's relMSE (metrics.relmse: squared error over reference² + 0.01, averaged).
