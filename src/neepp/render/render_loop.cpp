@@ -597,7 +597,7 @@ void RenderLoop::display_within_passes() {
             continue;
         }
         lock.unlock();
-        const double start = budget_.elapsed();
+        const double cpu_start = cpu_seconds(CpuClock::thread);
         std::optional<DisplayFrame> frame = frame_within_pass(pass, tiles_shown);
         lock.lock();
         if (display_stop_) break;
@@ -614,9 +614,10 @@ void RenderLoop::display_within_passes() {
             return;
         }
         last_display_ = budget_.elapsed();
-        // The frame costs one of the render's threads this time (the image copied and resolved): at most about
-        // 5 % of it.
-        display_wait_ = std::max(job_.display_interval_s, 20 * (last_display_ - start));
+        // What a frame costs the render is the CPU time it takes from the workers (the image copied and
+        // resolved, on_display): at most about 5 % of a core. Not its wall time, which on a machine that the
+        // workers keep busy is mostly theirs.
+        display_wait_ = std::max(job_.display_interval_s, 20 * (cpu_seconds(CpuClock::thread) - cpu_start));
     }
 }
 
