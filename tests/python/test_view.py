@@ -278,6 +278,9 @@ def test_live_render_shows_a_pass_under_way():
     assert any(f["spp_mean"] < f["spp_max"] for f in within)  # part of a pass's tiles
     means = [f["spp_mean"] for f in frames]
     assert means == sorted(means)  # never an older image after a newer one
+    # A pass shown under way is shown at its end too: where the map view may be asked.
+    between = {f["spp"] for f in frames if not f["within_pass"] and not f["final"]}
+    assert {f["spp"] + 1 for f in within} - {4} <= between, (within, between)
     assert frames[-1]["final"] and not frames[-1]["within_pass"] and frames[-1]["spp_mean"] == 4
 
 

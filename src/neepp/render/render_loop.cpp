@@ -312,6 +312,7 @@ private:
     std::condition_variable display_wake_;
     bool display_stop_ = false;
     int shown_passes_ = 0;  // completed passes in the newest frame shown
+    int shown_within_ = -1;  // the index of the last pass shown under way
     std::exception_ptr display_error_;
     std::thread display_thread_;
 };
@@ -529,7 +530,11 @@ void RenderLoop::render_tile(size_t index, int s0, int size, Batch &batch, Rende
 void RenderLoop::show_between_passes() {
     const std::lock_guard<std::mutex> lock(display_mutex_);
     if (display_error_) std::rethrow_exception(display_error_);
-    if (budget_.elapsed() - last_display_ < display_wait_) return;
+    // A pass that was shown under way is shown at its end too, whenever that is: the frame between passes is
+    // where on_display may read what the integrator learned (neepp view's map questions, which would
+    // otherwise wait as long as frames within passes keep coming), and the pass took longer than the
+    // interval, so the frame costs the render little.
+    if (budget_.elapsed() - last_display_ < display_wait_ && shown_within_ != result_.passes - 1) return;
     const double start = budget_.elapsed();
     job_.on_display(DisplayFrame{current_image(), result_.spp, budget_.elapsed(), counted(), false, result_.spp,
                                  double(result_.spp), false});
@@ -609,6 +614,7 @@ void RenderLoop::display_within_passes() {
         }
         try {
             job_.on_display(std::move(*frame));
+            shown_within_ = pass;
         } catch (...) {  // raised by the render's thread
             display_error_ = std::current_exception();
             return;
