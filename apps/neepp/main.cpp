@@ -186,14 +186,15 @@ Rendered run_render(const RenderArgs &a) {
                    load_s, name,
                    job.spp > 0 ? fmt::format("{} spp", job.spp) : fmt::format("{} s", job.time_limit_s));
 
-    // --display-server: the image after each pass (a few a second at most) and the final one, sent by a
-    // thread of the display's own; the image is named as the output file, so a render of the same file
-    // again replaces it in tev.
+    // --display-server: the image a few times a second (after a pass, or within a long one the tiles it
+    // finished, once a first pass is complete) and the final one, sent by a thread of the display's own;
+    // the image is named as the output file, so a render of the same file again replaces it in tev.
     std::unique_ptr<neepp::TevDisplay> display;
     if (!a.display_server.empty()) {
         display = std::make_unique<neepp::TevDisplay>(neepp::parse_server_address(a.display_server), a.output,
                                                       [](const std::string &w) { fmt::print(stderr, "neepp: warning: {}\n", w); });
         job.on_display = [&](neepp::DisplayFrame frame) { display->show(std::move(frame.image)); };
+        job.display_within_pass = true;
     }
 
     neepp::RenderResult result = neepp::render(*scene, *integrator, job);

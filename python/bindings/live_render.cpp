@@ -34,7 +34,11 @@ using OptionOverrides = std::map<std::string, std::string>;
 
 nb::dict frame_info(const DisplayFrame &f, int width, int height) {
     nb::dict d;
+    // Within a pass the finished tiles' pixels have its samples too: the fewest, the most and the mean.
     d["spp"] = f.spp;
+    d["spp_max"] = f.spp_max;
+    d["spp_mean"] = f.spp_mean;
+    d["within_pass"] = f.within_pass;
     d["render_time_s"] = f.render_time_s;
     d["width"] = width;
     d["height"] = height;
@@ -91,8 +95,11 @@ public:
     }
 
     // Renders up to spp samples per pixel (at 1/scale of the film's resolution: a coarse first image),
-    // calling on_frame(image, info) from this thread between passes (display_interval_s apart) and with the
-    // final image, until done or cancel(). Returns the statistics (JSON text, as render's).
+    // calling on_frame(image, info) display_interval_s apart and with the final image, until done or
+    // cancel(). Returns the statistics (JSON text, as render's). A frame comes from this thread between
+    // passes, or (info["within_pass"]) from a thread of the render's own while a pass runs, once the first
+    // is complete: the completed passes with the tiles of the running one that are finished, so that the
+    // image moves on ten times a second however long a pass of the scene takes. Never two at once.
     std::string render(int spp, int scale, double display_interval_s, nb::object on_frame) {
         if (spp < 1) throw std::invalid_argument("render: spp must be at least 1");
         if (scale < 1) throw std::invalid_argument("render: scale must be at least 1");
@@ -121,19 +128,22 @@ public:
         // so it starts afresh at each one.
         job.prepared = prepared_ && !dynamic_cast<const PassIntegrator *>(integrator_.get());
         job.display_interval_s = display_interval_s;
-        job.max_pass_s = display_interval_s;  // a pass longer than the interval would hold the image back
+        job.max_pass_s = display_interval_s;  // and a pass takes about that long, as far as one spp allows
+        job.display_within_pass = true;
         const int width = cam.width, height = cam.height;
         std::optional<nb::python_error> raised;
         if (!on_frame.is_none())
             job.on_display = [&](DisplayFrame frame) {
                 nb::gil_scoped_acquire acquire;
                 if (raised) return;
-                // Between passes: what the integrator learned holds still, so on_frame may look into it.
+                // Between passes what the integrator learned holds still, so on_frame may look into it; within
+                // a pass it is changing, and the map view is refused.
                 struct InFrame {
                     std::atomic<bool> &flag;
-                    InFrame(std::atomic<bool> &f) : flag(f) { flag = true; }
-                    ~InFrame() { flag = false; }
-                } in_frame{in_frame_};
+                    const bool between;
+                    InFrame(std::atomic<bool> &f, bool b) : flag(f), between(b) { if (between) flag = true; }
+                    ~InFrame() { if (between) flag = false; }
+                } in_frame{in_frame_, !frame.within_pass};
                 try {
                     nb::dict info = frame_info(frame, width, height);
                     on_frame(to_numpy(std::move(frame.image)), info);
@@ -269,7 +279,8 @@ private:
     }
     void refuse_during_pass(const char *what) const {
         if (rendering_ && !in_frame_)
-            throw std::runtime_error(std::string("LiveRender.") + what + ": only between renders or from on_frame");
+            throw std::runtime_error(std::string("LiveRender.") + what +
+                                     ": only between renders or from on_frame between passes");
     }
     void save_visibility_map_file(const std::string &path, const VoxelGrid &grid, const VisibilityMap &map) const {
         neepp::save_visibility_map(path, grid, map, scene_fingerprint(scene_));

@@ -255,6 +255,35 @@ def test_live_render_a_kept_map_makes_a_new_views_first_frames_cheaper():
     assert per_ray < 0.5, (per_ray, kept_rays, fresh_rays)
 
 
+def test_live_render_shows_a_pass_under_way():
+    # A pass of one sample per pixel far longer than the display interval: frames come within it (the
+    # tiles it finished over the completed passes), say so, and say how many samples their pixels have.
+    scene = neepp.load(DEMO, resx=256, resy=144)
+    live = neepp._neepp.LiveRender(scene, "path", {"shadow_rays": "nee"}, 1, "", 0)
+    frames, refused = [], []
+
+    def on_frame(image, info):
+        frames.append(info)
+        if info["within_pass"]:  # what the integrator learns is changing: the map view waits for a pass's end
+            with pytest.raises(RuntimeError, match="on_frame"):
+                live.map_info()
+            refused.append(True)
+
+    stats = json.loads(live.render(4, display_interval=0.01, on_frame=on_frame))
+    assert stats["spp"] == 4 and stats["passes"] == 4  # passes of one sample per pixel
+    within = [f for f in frames if f["within_pass"]]
+    assert len(within) >= 3 and len(refused) == len(within)
+    for f in within:
+        assert f["spp"] < f["spp_mean"] <= f["spp_max"] == f["spp"] + 1 <= 4 and not f["final"]
+    assert any(f["spp_mean"] < f["spp_max"] for f in within)  # part of a pass's tiles
+    means = [f["spp_mean"] for f in frames]
+    assert means == sorted(means)  # never an older image after a newer one
+    # A pass shown under way is shown at its end too: where the map view may be asked.
+    between = {f["spp"] for f in frames if not f["within_pass"] and not f["final"]}
+    assert {f["spp"] + 1 for f in within} - {4} <= between, (within, between)
+    assert frames[-1]["final"] and not frames[-1]["within_pass"] and frames[-1]["spp_mean"] == 4
+
+
 def test_live_render_cancel_stops_at_once():
     scene = neepp.load(DEMO, resx=64, resy=36)
     live = neepp._neepp.LiveRender(scene, "path", {}, 2, "", 0)

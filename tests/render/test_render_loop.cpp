@@ -1,7 +1,10 @@
 // The render loop: sample counts, time limits and cancellation, always ending with an image.
 #include <gtest/gtest.h>
 #include <atomic>
+#include <chrono>
+#include <mutex>
 #include <thread>
+#include "neepp/sampling/sampler.h"
 #include "test_scenes.h"
 
 using namespace neepp;
@@ -173,6 +176,133 @@ TEST(RenderLoop, APreparedIntegratorKeepsWhatItLearned) {
     job.prepared = false;
     const RenderResult fresh = render(*scene, *integ, job);
     EXPECT_EQ(merged_passes(*integ), uint64_t(fresh.passes));
+}
+
+// A slow integrator whose samples are random colours of their own sampler: a pass of it takes long enough
+// for the display to show it under way, and each pixel's value says which samples are in it.
+class SlowIntegrator final : public RayIntegrator {
+public:
+    explicit SlowIntegrator(std::chrono::microseconds per_sample) : per_sample_(per_sample) {}
+    Color Li(const Scene &, const Ray &, Sampler &sampler, RenderCounters &counters) const override {
+        std::this_thread::sleep_for(per_sample_);
+        ++counters.rays;
+        const float r = sampler.next_1d(), g = sampler.next_1d();
+        return Color(r, g, sampler.next_1d());
+    }
+    nlohmann::json describe() const override { return {{"name", "slow"}}; }
+
+private:
+    std::chrono::microseconds per_sample_;
+};
+
+// What a render showed: every frame, in order, and from which threads.
+struct Shown {
+    std::mutex mutex;
+    std::vector<DisplayFrame> frames;
+    void operator()(DisplayFrame f) {
+        std::lock_guard<std::mutex> lock(mutex);
+        frames.push_back(std::move(f));
+    }
+};
+
+TEST(RenderLoop, ShowsAPassUnderWayAsTheCompletedPassesAndWholeFinishedTiles) {
+    // A box filter: a pixel's value is its own samples' mean, so each pixel of a frame within the second
+    // pass is either the first pass's image or the second's, to the bit, and a tile is all one or the other.
+    auto scene = demo_scene(64, 32);
+    scene->settings.rfilter = "box";
+    scene->settings.rfilter_radius = 0.5f;
+    SlowIntegrator integ(std::chrono::microseconds(100));
+    RenderJob job;
+    job.tile_size = 8;
+    job.threads = 2;
+    job.spp = 1;
+    const Image first = render(*scene, integ, job).image;  // the first pass alone
+    job.spp = 3;                                           // passes of 1 and 2 spp
+    const RenderResult plain = render(*scene, integ, job);
+    ASSERT_EQ(plain.passes, 2);
+
+    Shown shown;
+    job.on_display = std::ref(shown);
+    job.display_within_pass = true;
+    job.display_interval_s = 0.005;
+    const RenderResult r = render(*scene, integ, job);
+    EXPECT_TRUE(r.image.data == plain.image.data);  // the frames only read
+    ASSERT_FALSE(shown.frames.empty());
+    EXPECT_TRUE(shown.frames.back().final);
+    EXPECT_TRUE(shown.frames.back().image.data == r.image.data);
+
+    const int W = 64, H = 32, T = 8;
+    int within = 0, partial = 0;
+    double last_mean = 0;
+    for (const DisplayFrame &f : shown.frames) {
+        EXPECT_GE(f.spp_mean, last_mean);  // never an older image after a newer one
+        last_mean = f.spp_mean;
+        if (!f.within_pass) {
+            EXPECT_EQ(f.spp_max, f.spp);
+            EXPECT_EQ(f.spp_mean, double(f.spp));
+            continue;
+        }
+        ++within;
+        EXPECT_FALSE(f.final);
+        EXPECT_EQ(f.spp, 1);  // none before the first pass is complete
+        ASSERT_EQ(f.image.width, W);
+        int tiles_ahead = 0;
+        for (int ty = 0; ty < H; ty += T)
+            for (int tx = 0; tx < W; tx += T) {
+                int as_first = 0, as_final = 0;
+                for (int y = ty; y < ty + T; ++y)
+                    for (int x = tx; x < tx + T; ++x)
+                        for (int c = 0; c < 3; ++c) {
+                            const size_t i = (size_t(y) * W + x) * 3 + c;
+                            as_first += f.image.data[i] == first.data[i];
+                            as_final += f.image.data[i] == plain.image.data[i];
+                        }
+                // A tile is all in or all out: never torn.
+                EXPECT_TRUE(as_first == T * T * 3 || as_final == T * T * 3) << "tile " << tx << "," << ty;
+                tiles_ahead += as_final == T * T * 3;
+            }
+        EXPECT_EQ(f.spp_max, tiles_ahead > 0 ? 3 : 1);
+        EXPECT_DOUBLE_EQ(f.spp_mean, 1 + 2 * double(tiles_ahead) / ((W / T) * (H / T)));
+        partial += tiles_ahead > 0 && tiles_ahead < (W / T) * (H / T);
+        EXPECT_EQ(f.counters.rays, uint64_t(W) * H);  // the completed pass's
+    }
+    // The second pass takes about 2048 samples x 100 us / 2 threads: frames every 5 ms show it under way.
+    EXPECT_GE(within, 3);
+    EXPECT_GE(partial, 2);
+}
+
+TEST(RenderLoop, FramesWithinAPassLeaveTheImageAndItsSumsAsTheyAre) {
+    // Path tracing (a gaussian filter: tiles' blocks overlap) and the splatting integrators, shown as often
+    // as the display thread can: the image and the sums are a render's without a display, to the bit. One
+    // thread: with more, tiles whose blocks overlap are added to the pass in the order they finish, and
+    // the sums of a pixel they share may differ in their last bits from one render to the next.
+    auto scene = demo_scene(64, 36);
+    for (const char *name : {"path", "bdpt", "light"}) {
+        SCOPED_TRACE(name);
+        auto integ = make_integrator(name, Options(OptionMap{{"shadow_rays", "nee"}}));
+        RenderJob job;
+        job.spp = 4;
+        job.tile_size = 8;
+        job.threads = 1;
+        job.keep_state = true;
+        const RenderResult plain = render(*scene, *integ, job);
+        Shown shown;
+        job.on_display = std::ref(shown);
+        job.display_within_pass = true;
+        job.display_interval_s = 0;
+        const RenderResult r = render(*scene, *integ, job);
+        EXPECT_TRUE(r.image.data == plain.image.data);
+        EXPECT_TRUE(r.state.image_sums == plain.state.image_sums);
+        EXPECT_TRUE(r.state.splat_sums == plain.state.splat_sums);
+        int within = 0;
+        for (const DisplayFrame &f : shown.frames) {
+            within += f.within_pass;
+            EXPECT_GE(f.spp, 1);
+            EXPECT_LE(f.spp_max, 4);
+            for (float v : f.image.data) ASSERT_TRUE(std::isfinite(v));
+        }
+        EXPECT_GT(within, 0);  // the frames were shown within a pass
+    }
 }
 
 TEST(RenderLoop, NeedsASampleCountOrATimeLimit) {

@@ -4,13 +4,16 @@ One session per server, shared by every page open on it: the camera, the integra
 Each change (a camera move, an option) cancels the render under way at once (LiveRender.cancel) and a
 thread of the session's own renders the new view: first a coarse image (a quarter of the resolution, one
 sample per pixel), then the full image, sent after each pass (a few times a second) as it converges, up to
-the most samples per pixel a view gets. The integrator is kept across camera moves, so NEE++'s visibility
-map, which belongs to the scene and not to the view, keeps learning from every view; a new integrator or
-new options start it afresh.
+the most samples per pixel a view gets. Within a pass, once a first is complete, the image is sent too
+(the completed passes with the tiles of the running pass that are finished), so that it moves on about ten
+times a second however long a pass of the scene takes. The integrator is kept across camera moves, so
+NEE++'s visibility map, which belongs to the scene and not to the view, keeps learning from every view; a
+new integrator or new options start it afresh.
 
-What the integrator learned is read by the render thread alone, between passes (from a frame's callback)
-or between renders: a page's question about the map (a clicked point) is queued for it and answered
-through a future, so that no pass ever runs while the map is read.
+What the integrator learned is read by the render thread alone, between passes (from the callback of a
+frame between passes, not of one within a pass) or between renders: a page's question about the map (a
+clicked point) is queued for it and answered through a future, so that no pass ever runs while the map is
+read.
 """
 from __future__ import annotations
 
@@ -46,6 +49,9 @@ class ViewSession:
                  seed: Optional[int] = None, sampler: str = "", output_dir: Path = Path("neepp-view"),
                  display_interval: float = 0.1, preview: bool = True):
         self.scene = scene
+        # The film's size, read once: while the coarse image renders, the scene's camera has a quarter of it,
+        # and a page that connects then must still be told the image's size.
+        self.width, self.height = scene.width, scene.height
         self.integrator = integrator or scene.integrator
         self.base_options = dict(options)  # the command line's -I, under what the page switches
         self.page_options: dict = {}
@@ -97,7 +103,7 @@ class ViewSession:
     def state(self) -> dict:
         """What a page shows besides the image: the scene, the integrator, its options, the camera, and
         what there is to choose from."""
-        return {"type": "state", "scene": self.scene.path, "width": self.scene.width, "height": self.scene.height,
+        return {"type": "state", "scene": self.scene.path, "width": self.width, "height": self.height,
                 "integrator": self.integrator, "options": self.options(),
                 "scene_options": self.scene.integrator_options, "fov": self.camera.fov,
                 "max_spp": self.max_spp, "catalog": _neepp.catalog(), "reference": self.reference_name or None}
@@ -122,9 +128,9 @@ class ViewSession:
             self.reference, self.reference_name = None, ""
             return
         image = np.asarray(image, dtype=np.float32)
-        if image.ndim != 3 or image.shape[2] < 3 or image.shape[:2] != (self.scene.height, self.scene.width):
+        if image.ndim != 3 or image.shape[2] < 3 or image.shape[:2] != (self.height, self.width):
             raise ValueError(f"the reference {name} is {'x'.join(map(str, image.shape[1::-1]))}, the image "
-                             f"{self.scene.width}x{self.scene.height}")
+                             f"{self.width}x{self.height}")
         if not np.all(np.isfinite(image[..., :3])):
             raise ValueError(f"the reference {name} has pixels that are not finite")
         self.reference, self.reference_name = np.ascontiguousarray(image[..., :3]), name
@@ -163,8 +169,8 @@ class ViewSession:
                 future.set_exception(e)
 
     def _map_view(self, x: int, y: int):
-        if not (0 <= x < self.scene.width and 0 <= y < self.scene.height):
-            raise ValueError(f"pixel ({x}, {y}) is outside the {self.scene.width}x{self.scene.height} image")
+        if not (0 <= x < self.width and 0 <= y < self.height):
+            raise ValueError(f"pixel ({x}, {y}) is outside the {self.width}x{self.height} image")
         camera = {"to_world": self.camera_in_render["to_world"], "fov": self.camera_in_render["fov"]}
         result = {"type": "map", "view": self.view_in_render, "x": x, "y": y, "integrator": self.integrator,
                   "options": self.options(), **camera}
@@ -276,12 +282,15 @@ class ViewSession:
         self.on_message(self.state())
 
     def _frame(self, view: int, camera: dict, image: np.ndarray, info: dict, coarse: bool) -> None:
-        self._answer_requests()  # between passes: the map holds still
+        if not info["within_pass"]:
+            self._answer_requests()  # between passes: the map holds still (within one it is learning)
         if not self._current(view):  # a cancelled render's last image: of a view no longer shown
             return
         t = info["render_time_s"]
+        # Within a pass the tiles it finished have more samples than the others: spp is the fewest a pixel
+        # has, spp_max the most, spp_mean their mean (the samples in the image).
         stats = {**info, "view": view, "coarse": coarse, "integrator": self.integrator, "options": self.options(),
-                 "samples_per_s": info["spp"] * info["width"] * info["height"] / t if t > 0 else 0.0, **camera}
+                 "samples_per_s": info["spp_mean"] * info["width"] * info["height"] / t if t > 0 else 0.0, **camera}
         reference = self.reference
         if not coarse and reference is not None and reference.shape == image.shape:
             # neepp compare's relMSE (metrics.relmse: squared error over reference² + 0.01, averaged).

@@ -3,10 +3,14 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <condition_variable>
+#include <exception>
 #include <limits>
 #include <memory>
 #include <mutex>
+#include <optional>
 #include <set>
+#include <thread>
 #include <tbb/enumerable_thread_specific.h>
 #include <tbb/global_control.h>
 #include <tbb/parallel_for.h>
@@ -184,8 +188,10 @@ public:
         // Per pixel: the image and the pass (ImageBlock, 32 bytes each), the image resolved for the pass
         // statistics and for the result (12 each), the PNG's bytes (4); with splats, two splat films (24
         // bytes each) and the splat layer resolved (12).
+        // Frames within a pass keep each tile's block (with its border) and copy the image (32 each).
         check_film_fits_in_memory(scene.camera.width, scene.camera.height,
-                                  2 * 32 + 2 * 12 + 4 + (splats(integrator) ? 2 * 24 + 12 : 0));
+                                  2 * 32 + 2 * 12 + 4 + (splats(integrator) ? 2 * 24 + 12 : 0) +
+                                      (job.display_within_pass && job.on_display ? 2 * 32 + 12 : 0));
     }
 
     RenderLoop(const Scene &scene, Integrator &integrator, const RenderJob &job);
@@ -195,9 +201,18 @@ public:
     RenderResult run() {
         return arena_.execute([this] { return run_in_arena(); });
     }
+    ~RenderLoop() { stop_display_thread(); }
 
 private:
     RenderResult run_in_arena();
+    // The image between passes, when the display interval has passed (the render's thread).
+    void show_between_passes();
+    // Frames within a pass (RenderJob::display_within_pass): the display thread's loop, the frame it
+    // makes of the completed passes and the tiles of the running pass published so far (none when there
+    // is nothing new since the frame of that pass shown last), and its end.
+    void display_within_passes();
+    std::optional<DisplayFrame> frame_within_pass(int &pass, size_t &tiles_shown);
+    void stop_display_thread();
 
     bool cancelled() const { return job_.cancel && job_.cancel->load(); }
     // One pass of `size` samples per pixel into pass_block_ (and splats_pass_); false when it was cut short.
@@ -270,6 +285,36 @@ private:
     double last_display_ = -std::numeric_limits<double>::infinity();  // the first pass is shown
     double display_wait_ = 0;
     RenderResult result_;
+
+    // Frames within a pass. A tile's worker fills the tile's own block, merges it into pass_block_ as
+    // always (so the image and its sums are the same with these frames or without), and then publishes
+    // the block (release); the display thread reads only published blocks (acquire), which no one writes
+    // again until the next pass, whose start clears the marks under pass_state_mutex_. The workers take no
+    // lock of the display's and never wait for it; the render's thread takes pass_state_mutex_ at a pass's
+    // start and end only (the display thread holds it while it copies the image, a few milliseconds).
+    const bool display_within_pass_;
+    std::vector<std::unique_ptr<ImageBlock>> tile_blocks_;
+    std::unique_ptr<std::atomic<bool>[]> tile_published_;
+    std::atomic<size_t> tiles_published_{0};
+    // accumulated_, the splats and light_paths_ (written by the render's thread, under it, at a pass's
+    // end only) and the running pass, as the display thread reads them.
+    std::mutex pass_state_mutex_;
+    struct PassState {
+        bool running = false;
+        int passes = 0;      // completed before it
+        int spp = 0;         // samples per pixel of the completed passes
+        int size = 0;        // its samples per pixel
+        RenderCounters counted;  // of the completed passes
+    } pass_state_;
+    // One on_display call at a time, from either thread; last_display_, display_wait_, what was shown
+    // last, the display thread's stop and an exception its on_display threw (raised by the render).
+    std::mutex display_mutex_;
+    std::condition_variable display_wake_;
+    bool display_stop_ = false;
+    int shown_passes_ = 0;  // completed passes in the newest frame shown
+    int shown_within_ = -1;  // the index of the last pass shown under way
+    std::exception_ptr display_error_;
+    std::thread display_thread_;
 };
 
 RenderLoop::RenderLoop(const Scene &scene, Integrator &integrator, const RenderJob &job)
@@ -282,11 +327,20 @@ RenderLoop::RenderLoop(const Scene &scene, Integrator &integrator, const RenderJ
       prototype_(make_sampler(job.sampler, job.seed)),
       threads_(job.threads > 0 ? job.threads : tbb::info::default_concurrency()),
       pool_(size_t(threads_)), arena_(threads_), budget_(job),
-      cpu_start_(cpu_seconds(CpuClock::process)) {
+      cpu_start_(cpu_seconds(CpuClock::process)),
+      // PSSMLT's pass body has no tiles: its image is all of its chains' splats, known only at the pass's end.
+      display_within_pass_(job.display_within_pass && bool(job.on_display) && !passes_) {
     border_ = int(std::ceil(filter_.radius() - 0.5f));
     if (splatting_) {
         splats_accumulated_ = std::make_unique<SplatFilm>(W_, H_, &filter_);
         splats_pass_ = std::make_unique<SplatFilm>(W_, H_, &filter_);
+    }
+    if (display_within_pass_) {
+        for (const Tile &t : tiles_)
+            tile_blocks_.push_back(std::make_unique<ImageBlock>(t.x0 - border_, t.y0 - border_, t.w + 2 * border_,
+                                                                t.h + 2 * border_, &filter_));
+        tile_published_.reset(new std::atomic<bool>[tiles_.size()]);
+        for (size_t i = 0; i < tiles_.size(); ++i) tile_published_[i].store(false, std::memory_order_relaxed);
     }
 }
 
@@ -316,6 +370,7 @@ RenderResult RenderLoop::run_in_arena() {
 
     last_checkpoint_ = budget_.elapsed();
     bool checkpointed_at_stop = false;
+    if (display_within_pass_) display_thread_ = std::thread([this] { display_within_passes(); });
     for (;;) {
         if (cancelled()) { result_.stopped_by = "cancel"; break; }
         if (budget_.timed() && budget_.remaining() <= 0) { result_.stopped_by = "time"; break; }
@@ -340,18 +395,13 @@ RenderResult RenderLoop::run_in_arena() {
             job_.on_snapshot(result_.spp, last_snapshot_, current_image());
         }
         if (budget_.spp_reached(result_.spp)) { result_.stopped_by = "spp"; break; }  // the final image is shown below
-        if (job_.on_display && budget_.elapsed() - last_display_ >= display_wait_) {
-            const double start = budget_.elapsed();
-            job_.on_display(DisplayFrame{current_image(), result_.spp, budget_.elapsed(), counted(), false});
-            last_display_ = budget_.elapsed();
-            // Resolving the image is the render's time: a large image is shown less often, so that it costs
-            // at most about 5 % of the render.
-            display_wait_ = std::max(job_.display_interval_s, 20 * (last_display_ - start));
-        }
+        if (job_.on_display) show_between_passes();
         if (job_.on_checkpoint && budget_.elapsed() - last_checkpoint_ >= job_.checkpoint_interval_s) checkpoint(counted());
     }
     // Stopped before its sample count between passes (time, Ctrl-C): what a resume continues from.
     if (job_.on_checkpoint && result_.stopped_by != "spp" && !checkpointed_at_stop && result_.passes > 0) checkpoint(counted());
+    stop_display_thread();  // no frame of a pass after the final one
+    if (display_error_) std::rethrow_exception(display_error_);
     bar.finish();
 
     result_.render_time_s = budget_.elapsed();
@@ -359,7 +409,9 @@ RenderResult RenderLoop::run_in_arena() {
     result_.counters = counted();
     result_.occlusion_time_s = double(result_.counters.occlusion_ticks) * seconds_per_tick();
     result_.image = current_image();
-    if (job_.on_display) job_.on_display(DisplayFrame{result_.image, result_.spp, result_.render_time_s, result_.counters, true});
+    if (job_.on_display)
+        job_.on_display(DisplayFrame{result_.image, result_.spp, result_.render_time_s, result_.counters, true,
+                                     result_.spp, double(result_.spp), false});
     if (job_.keep_state) result_.state = make_checkpoint(result_.counters);
     return std::move(result_);
 }
@@ -368,6 +420,14 @@ bool RenderLoop::render_pass(int size) {
     const int s0 = result_.spp;
     if (job_.on_checkpoint) counted_at_pass_start_ = counted();
     pass_block_.clear();
+    {
+        const std::lock_guard<std::mutex> lock(pass_state_mutex_);
+        if (display_within_pass_) {
+            for (size_t i = 0; i < tiles_.size(); ++i) tile_published_[i].store(false, std::memory_order_relaxed);
+            tiles_published_.store(0, std::memory_order_relaxed);
+        }
+        pass_state_ = PassState{true, result_.passes, s0, size, display_within_pass_ ? counted() : RenderCounters{}};
+    }
     samples_done_ = 0;
     aborted_ = false;
     one_off_s_ = 0;
@@ -401,13 +461,11 @@ bool RenderLoop::render_pass(int size) {
             }
         });
     });
-    if (aborted_) {
-        // Keep a partial first pass rather than nothing at all: every pixel it reached is unbiased.
-        if (result_.passes == 0) merge_pass(pass_light_paths);
-        return false;
-    }
-    merge_pass(pass_light_paths);
-    return true;
+    const std::lock_guard<std::mutex> lock(pass_state_mutex_);
+    pass_state_.running = false;
+    // Keep a partial first pass rather than nothing at all: every pixel it reached is unbiased.
+    if (!aborted_ || result_.passes == 0) merge_pass(pass_light_paths);
+    return !aborted_;
 }
 
 void RenderLoop::render_tile(size_t index, int s0, int size, Batch &batch, RenderCounters &c) {
@@ -417,7 +475,11 @@ void RenderLoop::render_tile(size_t index, int s0, int size, Batch &batch, Rende
     std::vector<Vec2> &film_pos = batch.film_pos;
     std::vector<Color> &radiance = batch.radiance;
     double m2 = 0;
-    ImageBlock block(t.x0 - border_, t.y0 - border_, t.w + 2 * border_, t.h + 2 * border_, &filter_);
+    // The tile's samples: a block of its own, kept for the display thread when it shows passes under way.
+    std::optional<ImageBlock> own;
+    ImageBlock &block = display_within_pass_
+                            ? (tile_blocks_[index]->clear(), *tile_blocks_[index])
+                            : own.emplace(t.x0 - border_, t.y0 - border_, t.w + 2 * border_, t.h + 2 * border_, &filter_);
     int queued = 0;
     auto add = [&](const Vec2 &pos, Color L) {
         // Only NaN/inf are dropped: negative values are legitimate for unbiased estimators such as NEE++'s
@@ -455,8 +517,124 @@ void RenderLoop::render_tile(size_t index, int s0, int size, Batch &batch, Rende
     if (queued > 0) flush();
     tile_m2_[index] = m2;
     samples_done_ += uint64_t(t.w) * t.h * size;
-    std::lock_guard<std::mutex> lock(merge_mutex_);
-    pass_block_.merge(block);
+    {
+        std::lock_guard<std::mutex> lock(merge_mutex_);
+        pass_block_.merge(block);
+    }
+    if (display_within_pass_) {
+        tile_published_[index].store(true, std::memory_order_release);
+        tiles_published_.fetch_add(1, std::memory_order_release);
+    }
+}
+
+void RenderLoop::show_between_passes() {
+    const std::lock_guard<std::mutex> lock(display_mutex_);
+    if (display_error_) std::rethrow_exception(display_error_);
+    // A pass that was shown under way is shown at its end too, whenever that is: the frame between passes is
+    // where on_display may read what the integrator learned (neepp view's map questions, which would
+    // otherwise wait as long as frames within passes keep coming), and the pass took longer than the
+    // interval, so the frame costs the render little.
+    if (budget_.elapsed() - last_display_ < display_wait_ && shown_within_ != result_.passes - 1) return;
+    const double start = budget_.elapsed();
+    job_.on_display(DisplayFrame{current_image(), result_.spp, budget_.elapsed(), counted(), false, result_.spp,
+                                 double(result_.spp), false});
+    shown_passes_ = result_.passes;
+    last_display_ = budget_.elapsed();
+    // Resolving the image is the render's time: a large image is shown less often, so that it costs at most
+    // about 5 % of the render.
+    display_wait_ = std::max(job_.display_interval_s, 20 * (last_display_ - start));
+}
+
+std::optional<DisplayFrame> RenderLoop::frame_within_pass(int &pass, size_t &tiles_shown) {
+    std::optional<ImageBlock> samples;
+    Image splat;
+    DisplayFrame frame;
+    uint64_t pixels_ahead = 0;  // pixels with the running pass's samples
+    {
+        const std::lock_guard<std::mutex> lock(pass_state_mutex_);
+        const PassState &p = pass_state_;
+        // Before the first pass is complete, a pixel of a tile not yet finished has no sample at all: the
+        // frame would be black there, a worse picture than none (neepp view shows its coarse image then).
+        if (!p.running || p.passes == 0) return std::nullopt;
+        if (tiles_published_.load(std::memory_order_acquire) == (p.passes == pass ? tiles_shown : 0)) return std::nullopt;
+        samples.emplace(accumulated_);
+        size_t tiles = 0;
+        for (size_t i = 0; i < tiles_.size(); ++i)
+            if (tile_published_[i].load(std::memory_order_acquire)) {
+                samples->merge(*tile_blocks_[i]);
+                pixels_ahead += uint64_t(tiles_[i].w) * tiles_[i].h;
+                ++tiles;
+            }
+        if (p.passes == pass && tiles == tiles_shown) return std::nullopt;
+        pass = p.passes;
+        tiles_shown = tiles;
+        // A splatting integrator's image is two layers, each its own estimate of its share of the pixel:
+        // the camera samples' (normalised by each pixel's weights) and the splats' (by the light paths).
+        // The running pass's splats land anywhere while its tiles run, and its light paths are counted at
+        // its end, so a frame within the pass has the completed passes' splats and the camera samples of
+        // the finished tiles besides theirs: each layer still estimates its share, so the frame is a
+        // correct, if unevenly sampled, image.
+        if (splatting_ && light_paths_ > 0)
+            splat = splats_accumulated_->resolve(double(W_) * H_ / light_paths_);
+        frame.spp = p.spp;
+        frame.spp_max = pixels_ahead > 0 ? p.spp + p.size : p.spp;
+        frame.spp_mean = p.spp + p.size * (double(pixels_ahead) / (double(W_) * H_));
+        frame.counters = p.counted;
+    }
+    frame.image = samples->resolve();
+    if (!splat.data.empty())
+        for (size_t i = 0; i < frame.image.data.size(); ++i) frame.image.data[i] += splat.data[i];
+    frame.render_time_s = budget_.elapsed();
+    frame.within_pass = true;
+    return frame;
+}
+
+void RenderLoop::display_within_passes() {
+    // Tiles finish at any time: with nothing new to show, look again a few times per interval.
+    const auto poll = std::chrono::duration<double>(std::clamp(job_.display_interval_s / 4, 0.005, 0.05));
+    int pass = -1;
+    size_t tiles_shown = 0;
+    std::unique_lock<std::mutex> lock(display_mutex_);
+    while (!display_stop_) {
+        const double due = last_display_ + display_wait_ - budget_.elapsed();
+        if (due > 0) {
+            display_wake_.wait_for(lock, std::chrono::duration<double>(due));
+            continue;
+        }
+        lock.unlock();
+        const double cpu_start = cpu_seconds(CpuClock::thread);
+        std::optional<DisplayFrame> frame = frame_within_pass(pass, tiles_shown);
+        lock.lock();
+        if (display_stop_) break;
+        // Nothing new, or the render's thread has shown the end of this pass meanwhile (an image going back
+        // would flicker).
+        if (!frame || shown_passes_ > pass) {
+            display_wake_.wait_for(lock, poll);
+            continue;
+        }
+        try {
+            job_.on_display(std::move(*frame));
+            shown_within_ = pass;
+        } catch (...) {  // raised by the render's thread
+            display_error_ = std::current_exception();
+            return;
+        }
+        last_display_ = budget_.elapsed();
+        // What a frame costs the render is the CPU time it takes from the workers (the image copied and
+        // resolved, on_display): at most about 5 % of a core. Not its wall time, which on a machine that the
+        // workers keep busy is mostly theirs.
+        display_wait_ = std::max(job_.display_interval_s, 20 * (cpu_seconds(CpuClock::thread) - cpu_start));
+    }
+}
+
+void RenderLoop::stop_display_thread() {
+    if (!display_thread_.joinable()) return;
+    {
+        const std::lock_guard<std::mutex> lock(display_mutex_);
+        display_stop_ = true;
+    }
+    display_wake_.notify_all();
+    display_thread_.join();
 }
 
 void RenderLoop::merge_pass(uint64_t pass_light_paths) {

@@ -17,12 +17,20 @@ class Scene;
 class Integrator;
 
 // What a live view of the render is shown (RenderJob::on_display): the image so far and what made it.
+// Within a pass (RenderJob::display_within_pass) the pixels of the tiles the pass has finished have its
+// samples too, the others not yet: spp is what every pixel has, spp_max what the most have, spp_mean the
+// mean over the pixels; between passes the three are equal.
 struct DisplayFrame {
     Image image;
-    int spp = 0;                // samples per pixel in the image
+    int spp = 0;                // samples per pixel that every pixel of the image has
     double render_time_s = 0;
-    RenderCounters counters;    // of the samples in the image
+    RenderCounters counters;    // of the samples in the image (within a pass: of the completed passes)
     bool final = false;         // the render's last image
+    int spp_max = 0;
+    double spp_mean = 0;
+    // Shown while a pass runs (from a thread of the render loop's own, not a tile worker): what the
+    // integrator learns between passes is changing, so the callback must not read it then.
+    bool within_pass = false;
 };
 
 struct RenderJob {
@@ -56,6 +64,12 @@ struct RenderJob {
     // its own); it only reads, so the image is the same with it or without.
     double display_interval_s = 0.25;
     std::function<void(DisplayFrame)> on_display;
+    // Also show the image while a pass runs, display_interval_s apart, once a first pass is complete: the
+    // completed passes with the tiles of the running pass that are finished (DisplayFrame::within_pass),
+    // so that a pass longer than the interval (a slow scene, a large image) does not hold the image back.
+    // on_display is then called from a second thread of the render's own too (never at once with the
+    // first), and each tile's samples are kept until the pass ends (about 32 more bytes per pixel).
+    bool display_within_pass = false;
     // 0: passes as large as the render loop likes (up to 32 spp). An interactive view (neepp view) sets
     // about its display interval: each pass then takes about that long at the last pass's speed (at least
     // one sample per pixel), so that the image can be shown that often.

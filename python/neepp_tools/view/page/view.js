@@ -192,7 +192,8 @@ function showStats(h) {
   const tested = h.shadow_rays + h.shadow_rays_skipped;
   const text = {
     view: h.view + (h.coarse ? " (coarse)" : ""),
-    spp: String(h.spp),
+    // Within a pass the tiles it finished have its samples too.
+    spp: h.spp_max > h.spp ? `${h.spp}–${h.spp_max} (mean ${h.spp_mean.toFixed(2)})` : String(h.spp),
     samples_per_s: formatCount(h.samples_per_s),
     render_time_s: h.render_time_s.toFixed(2) + " s",
     rays: formatCount(h.rays),
