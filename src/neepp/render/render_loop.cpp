@@ -228,6 +228,9 @@ private:
     };
     // The tile loop's share of a pass: each tile's samples, in batches, into the tile's block.
     void render_tile(size_t index, int s0, int size, Batch &batch, RenderCounters &c);
+    // A finished tile's block into pass_block_, in tile order (see waiting_).
+    void merge_tile(size_t index, std::unique_ptr<ImageBlock> own);
+    void merge_tiles_left();
     void merge_pass(uint64_t pass_light_paths);
     // Light paths the pass's camera samples splatted (an integrator's own pass body counts its own).
     double camera_sample_light_paths() const {
@@ -266,6 +269,14 @@ private:
     double light_paths_ = 0;
     std::mutex merge_mutex_;
     std::vector<Tile> tiles_;
+    // Tiles are added to pass_block_ in tile order, whichever finishes first: a pixel near a tile's edge
+    // takes samples from up to four tiles' blocks, and sums in the order the tiles finish would differ in
+    // their last bits from one multithreaded render to the next. A tile finished before its turn waits
+    // here (its block, or only its mark where tile_blocks_ keeps it); the tile loop hands tiles out
+    // roughly in order, so few wait. Under merge_mutex_.
+    std::vector<std::unique_ptr<ImageBlock>> waiting_;
+    std::vector<char> finished_;
+    size_t next_merge_ = 0;
     std::vector<double> tile_m2_;  // Σ lum(L)² per tile this pass, summed in tile order
     const std::unique_ptr<Sampler> prototype_;
     const int threads_;
@@ -286,7 +297,7 @@ private:
     double display_wait_ = 0;
     RenderResult result_;
 
-    // Frames within a pass. A tile's worker fills the tile's own block, merges it into pass_block_ as
+    // Frames within a pass. A tile's worker fills the tile's own block, hands it to pass_block_ as
     // always (so the image and its sums are the same with these frames or without), and then publishes
     // the block (release); the display thread reads only published blocks (acquire), which no one writes
     // again until the next pass, whose start clears the marks under pass_state_mutex_. The workers take no
@@ -323,7 +334,8 @@ RenderLoop::RenderLoop(const Scene &scene, Integrator &integrator, const RenderJ
       passes_(dynamic_cast<PassIntegrator *>(&integrator)), splatting_(splats(integrator)),
       filter_(scene.settings.rfilter, scene.settings.rfilter_radius, scene.settings.rfilter_stddev),
       accumulated_((check_job(scene, integrator, job), 0), 0, W_, H_, &filter_), pass_block_(0, 0, W_, H_, &filter_),
-      tiles_(make_tiles(W_, H_, job.tile_size)), tile_m2_(tiles_.size()),
+      tiles_(make_tiles(W_, H_, job.tile_size)), waiting_(tiles_.size()), finished_(tiles_.size()),
+      tile_m2_(tiles_.size()),
       prototype_(make_sampler(job.sampler, job.seed)),
       threads_(job.threads > 0 ? job.threads : tbb::info::default_concurrency()),
       pool_(size_t(threads_)), arena_(threads_), budget_(job),
@@ -420,6 +432,8 @@ bool RenderLoop::render_pass(int size) {
     const int s0 = result_.spp;
     if (job_.on_checkpoint) counted_at_pass_start_ = counted();
     pass_block_.clear();
+    std::fill(finished_.begin(), finished_.end(), 0);
+    next_merge_ = 0;
     {
         const std::lock_guard<std::mutex> lock(pass_state_mutex_);
         if (display_within_pass_) {
@@ -461,6 +475,7 @@ bool RenderLoop::render_pass(int size) {
             }
         });
     });
+    merge_tiles_left();
     const std::lock_guard<std::mutex> lock(pass_state_mutex_);
     pass_state_.running = false;
     // Keep a partial first pass rather than nothing at all: every pixel it reached is unbiased.
@@ -476,10 +491,11 @@ void RenderLoop::render_tile(size_t index, int s0, int size, Batch &batch, Rende
     std::vector<Color> &radiance = batch.radiance;
     double m2 = 0;
     // The tile's samples: a block of its own, kept for the display thread when it shows passes under way.
-    std::optional<ImageBlock> own;
+    std::unique_ptr<ImageBlock> own;
     ImageBlock &block = display_within_pass_
                             ? (tile_blocks_[index]->clear(), *tile_blocks_[index])
-                            : own.emplace(t.x0 - border_, t.y0 - border_, t.w + 2 * border_, t.h + 2 * border_, &filter_);
+                            : *(own = std::make_unique<ImageBlock>(t.x0 - border_, t.y0 - border_, t.w + 2 * border_,
+                                                                   t.h + 2 * border_, &filter_));
     int queued = 0;
     auto add = [&](const Vec2 &pos, Color L) {
         // Only NaN/inf are dropped: negative values are legitimate for unbiased estimators such as NEE++'s
@@ -517,13 +533,30 @@ void RenderLoop::render_tile(size_t index, int s0, int size, Batch &batch, Rende
     if (queued > 0) flush();
     tile_m2_[index] = m2;
     samples_done_ += uint64_t(t.w) * t.h * size;
-    {
-        std::lock_guard<std::mutex> lock(merge_mutex_);
-        pass_block_.merge(block);
-    }
+    merge_tile(index, std::move(own));
     if (display_within_pass_) {
         tile_published_[index].store(true, std::memory_order_release);
         tiles_published_.fetch_add(1, std::memory_order_release);
+    }
+}
+
+void RenderLoop::merge_tile(size_t index, std::unique_ptr<ImageBlock> own) {
+    const std::lock_guard<std::mutex> lock(merge_mutex_);
+    finished_[index] = 1;
+    waiting_[index] = std::move(own);
+    for (; next_merge_ < tiles_.size() && finished_[next_merge_]; ++next_merge_) {
+        pass_block_.merge(display_within_pass_ ? *tile_blocks_[next_merge_] : *waiting_[next_merge_]);
+        waiting_[next_merge_].reset();
+    }
+}
+
+// A pass cut short: the tiles that finished after one that did not, still in tile order.
+void RenderLoop::merge_tiles_left() {
+    const std::lock_guard<std::mutex> lock(merge_mutex_);
+    for (; next_merge_ < tiles_.size(); ++next_merge_) {
+        if (!finished_[next_merge_]) continue;
+        pass_block_.merge(display_within_pass_ ? *tile_blocks_[next_merge_] : *waiting_[next_merge_]);
+        waiting_[next_merge_].reset();
     }
 }
 
