@@ -345,6 +345,32 @@ TEST(RenderLoop, ShowsTheFirstPassUnderWayAsItsFinishedTilesAndMarksTheRest) {
     }
 }
 
+TEST(RenderLoop, FramesWithinAPassAreTheIntervalApartFromStartToStart) {
+    // What a frame within a pass takes (on_display here sleeps 60 ms; on a loaded machine, the wait for a
+    // core) does not add to the display interval: frames 50 ms apart come every 60 ms, where counting the
+    // interval from the end of the last frame made it 110 ms.
+    auto scene = demo_scene(64, 32);
+    SlowIntegrator integ(std::chrono::microseconds(100));
+    RenderJob job;
+    job.tile_size = 8;
+    job.threads = 2;
+    job.spp = 5;  // passes of 1 and 4 spp: about 0.1 s and 0.4 s
+    std::vector<double> starts;
+    job.on_display = [&](DisplayFrame f) {
+        if (!f.within_pass) return;  // (a slow frame between passes is the render's time: shown less often)
+        starts.push_back(f.render_time_s);
+        std::this_thread::sleep_for(std::chrono::milliseconds(60));
+    };
+    job.display_within_pass = true;
+    job.display_interval_s = 0.05;
+    render(*scene, integ, job);
+    ASSERT_GE(starts.size(), 4u);
+    std::vector<double> gaps;
+    for (size_t i = 1; i < starts.size(); ++i) gaps.push_back(starts[i] - starts[i - 1]);
+    std::nth_element(gaps.begin(), gaps.begin() + gaps.size() / 2, gaps.end());
+    EXPECT_LT(gaps[gaps.size() / 2], 0.09);
+}
+
 TEST(RenderLoop, FramesWithinAPassLeaveTheImageAndItsSumsAsTheyAre) {
     // Path tracing (a tent filter: tiles' blocks overlap) and the splatting integrators, shown as often
     // as the display thread can: the image and the sums are a render's without a display, to the bit. Path

@@ -308,6 +308,9 @@ private:
     double one_off_s_ = 0;  // seconds of the pass spent on one-off work (PSSMLT's bootstrap)
     double seconds_per_spp_ = 0;
     double last_checkpoint_ = 0, last_snapshot_ = 0;
+    // When the last frame shown began: frames are display_wait_ apart from start to start, so that what a
+    // frame takes (its image resolved, on_display, on a loaded machine the wait for a core) does not add to
+    // the interval.
     double last_display_ = -std::numeric_limits<double>::infinity();  // the first pass is shown
     double display_wait_ = 0;
     RenderResult result_;
@@ -589,10 +592,10 @@ void RenderLoop::show_between_passes() {
     job_.on_display(DisplayFrame{current_image(), result_.spp, budget_.elapsed(), counted(), false, result_.spp,
                                  double(result_.spp), false});
     shown_passes_ = result_.passes;
-    last_display_ = budget_.elapsed();
+    last_display_ = start;
     // Resolving the image is the render's time: a large image is shown less often, so that it costs at most
     // about 5 % of the render.
-    display_wait_ = std::max(job_.display_interval_s, 20 * (last_display_ - start));
+    display_wait_ = std::max(job_.display_interval_s, 20 * (budget_.elapsed() - start));
 }
 
 std::optional<DisplayFrame> RenderLoop::frame_within_pass(int &pass, size_t &tiles_shown) {
@@ -657,6 +660,7 @@ void RenderLoop::display_within_passes() {
             continue;
         }
         lock.unlock();
+        const double start = budget_.elapsed();
         const double cpu_start = cpu_seconds(CpuClock::thread);
         std::optional<DisplayFrame> frame = frame_within_pass(pass, tiles_shown);
         lock.lock();
@@ -674,7 +678,7 @@ void RenderLoop::display_within_passes() {
             display_error_ = std::current_exception();
             return;
         }
-        last_display_ = budget_.elapsed();
+        last_display_ = start;
         // What a frame costs the render is the CPU time it takes from the workers (the image copied and
         // resolved, on_display): at most about 5 % of a core. Not its wall time, which on a machine that the
         // workers keep busy is mostly theirs.
