@@ -4,7 +4,8 @@ neepp._neepp.LiveRender), without the web page:
 
   move to first image  the time from a camera command to the first image of the new view (the coarse one:
                        a quarter of the resolution, one sample per pixel), median of --moves moves
-  updates per second   full images of the new view delivered in the --window seconds after a move
+  updates per second   full-resolution images of the new view delivered in the --window seconds after a
+                       move (those of its first pass, its finished tiles over the coarse image, included)
   first-second relVar  the relative variance of a new view's image after its first second (wall time from
                        the render's start, the fresh render's map seeding included) with the map kept from
                        --train seconds of the previous view, against a fresh NEE++ render of the new view:

@@ -99,8 +99,10 @@ public:
     // cancel(). Returns the statistics (JSON text, as render's). A frame comes from this thread between
     // passes, or (info["within_pass"]) from a thread of the render's own while a pass runs, once the first
     // is complete: the completed passes with the tiles of the running one that are finished, so that the
-    // image moves on ten times a second however long a pass of the scene takes. Never two at once.
-    std::string render(int spp, int scale, double display_interval_s, nb::object on_frame) {
+    // image moves on ten times a second however long a pass of the scene takes. Never two at once. With
+    // first_pass_frames, within the first pass too: its finished tiles, NaN in the other pixels (info["spp"]
+    // 0), which the caller fills with what it has (neepp view: the coarse image of the view).
+    std::string render(int spp, int scale, double display_interval_s, nb::object on_frame, bool first_pass_frames) {
         if (spp < 1) throw std::invalid_argument("render: spp must be at least 1");
         if (scale < 1) throw std::invalid_argument("render: scale must be at least 1");
         if (rendering_.exchange(true)) throw std::runtime_error("LiveRender.render: not while a render runs");
@@ -130,6 +132,7 @@ public:
         job.display_interval_s = display_interval_s;
         job.max_pass_s = display_interval_s;  // and a pass takes about that long, as far as one spp allows
         job.display_within_pass = true;
+        job.display_first_pass = first_pass_frames;
         const int width = cam.width, height = cam.height;
         std::optional<nb::python_error> raised;
         if (!on_frame.is_none())
@@ -369,9 +372,11 @@ void bind_live_render(nb::module_ &m) {
         .def("set_camera", &LiveRender::set_camera, nb::arg("to_world"), nb::arg("fov"),
              "Places the camera: to_world (4 rows of 4, a rotation and a translation) and fov in degrees.")
         .def("render", &LiveRender::render, nb::arg("spp"), nb::arg("scale") = 1, nb::arg("display_interval") = 0.1,
-             nb::arg("on_frame").none() = nb::none(),
+             nb::arg("on_frame").none() = nb::none(), nb::arg("first_pass_frames") = false,
              "Renders up to spp samples per pixel at 1/scale of the resolution, calling on_frame(image, info) "
-             "between passes and with the final image, until done or cancel(); returns the statistics as JSON text.")
+             "between passes, within them (info['within_pass']) and with the final image, until done or cancel(); "
+             "returns the statistics as JSON text. first_pass_frames: frames within the first pass too, NaN in the "
+             "pixels of its unfinished tiles (info['spp'] 0).")
         .def("cancel", &LiveRender::cancel, "Stops the render under way (or the next one, until clear_cancel).")
         .def("clear_cancel", &LiveRender::clear_cancel)
         .def_prop_ro("prepared", &LiveRender::prepared,

@@ -4,6 +4,7 @@
 #include <nanobind/stl/tuple.h>
 #include <nanobind/stl/unique_ptr.h>
 #include <nanobind/stl/filesystem.h>
+#include <nanobind/stl/optional.h>
 #include "bindings.h"
 #include "neepp/scene/scene.h"
 #include "neepp/visibility/map_file.h"
@@ -50,15 +51,24 @@ void bind_visibility(nb::module_ &m) {
             nb::arg("scene"), nb::arg("resolution") = 16, nb::arg("samples_per_pair") = 16, nb::arg("seed") = 0,
             "Seeds a map for the scene with explicit visibility samples, as a NEE++ render does before its first "
             "pass (seed 0: the renderer's own).")
-        .def_static("load", [](const std::filesystem::path &path, const Scene &scene, int resolution) {
+        .def_static("load", [](const std::filesystem::path &path, const Scene &scene, std::optional<int> resolution) {
+                // The file's grid: the scene's bounds, or a grid_bounds=shading render's (neepp view saves such
+                // maps), which depend on the camera it rendered from and are known from the file alone.
                 auto m = std::make_unique<GriddedMap>();
-                m->grid = VoxelGrid(scene.bounds(), resolution);
                 m->fingerprint = scene_fingerprint(scene);
-                m->map = load_visibility_map(path.string(), m->grid, m->fingerprint);
+                auto [grid, map] = load_visibility_map(path.string(), m->fingerprint);
+                if (resolution && *resolution != grid.resolution())
+                    throw std::runtime_error("visibility map '" + path.string() + "': was built for a " +
+                                             std::to_string(grid.resolution()) + "^3 grid, not " +
+                                             std::to_string(*resolution) + "^3");
+                m->grid = grid;
+                m->map = std::move(map);
                 return m;
             },
-            nb::arg("path"), nb::arg("scene"), nb::arg("resolution") = 16,
-            "Reads a map file and checks that it belongs to this scene and grid resolution.")
+            nb::arg("path"), nb::arg("scene"), nb::arg("resolution").none() = nb::none(),
+            "Reads a map file with the grid it was written for (its resolution and bounds: the scene's, or a "
+            "grid_bounds=shading render's) and checks that it belongs to this scene (and, given one, to this grid "
+            "resolution).")
         .def("save", [](const GriddedMap &m, const std::filesystem::path &path) { save_visibility_map(path.string(), m.grid, m.map, m.fingerprint); },
              nb::arg("path"), "Writes the map file (replaced atomically); a render's visibility_map option reads it.")
         .def_prop_ro("resolution", [](const GriddedMap &m) { return m.grid.resolution(); }, "N: the grid has N^3 voxels.")

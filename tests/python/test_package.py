@@ -173,6 +173,39 @@ def test_visibility_map_round_trip(tmp_path):
     assert used["source"] == "loaded" and used["known_pairs"] == vmap.known_pairs
 
 
+def test_a_map_over_the_shading_points_bounds_loads_with_its_grid(tmp_path):
+    """A map from a grid_bounds=shading render (neepp view saves such maps) has a grid over where the camera's
+    paths shade, which only the file knows: load reads its grid from the file, the scene's fingerprint still
+    checked, and the counts are the render's."""
+    scene = neepp.load(DEMO, **SMALL)
+    path = tmp_path / "shading.vis"
+    _, stats = neepp.render(scene, spp=2, shadow_rays="neepp", voxels=8, grid_bounds="shading",
+                            visibility_map=str(path), learn=False)
+    built = stats["integrator_statistics"]["shadow_rays"]["map"]
+    loaded = neepp.VisibilityMap.load(path, scene)
+    scene_grid = neepp.VisibilityMap.build(scene, resolution=8, samples_per_pair=1)
+    assert loaded.resolution == 8 and loaded.known_pairs == built["known_pairs"] > 0
+    assert loaded.bounds != scene_grid.bounds  # the shading points' box, not the scene's
+    assert neepp.VisibilityMap.load(path, scene, resolution=8).known_pairs == loaded.known_pairs
+    with pytest.raises(RuntimeError, match="8\\^3 grid, not 16\\^3"):
+        neepp.VisibilityMap.load(path, scene, resolution=16)
+    with pytest.raises(RuntimeError, match="another scene"):
+        neepp.VisibilityMap.load(path, neepp.load(REPO / "scenes" / "office" / "scene.xml", **SMALL))
+    # Saved again and read by a render of the same bounds as its own map.
+    loaded.save(tmp_path / "again.vis")
+    _, again = neepp.render(scene, spp=2, shadow_rays="neepp", voxels=8, grid_bounds="shading",
+                            visibility_map=str(tmp_path / "again.vis"), learn=False)
+    used = again["integrator_statistics"]["shadow_rays"]["map"]
+    assert used["source"] == "loaded" and used["known_pairs"] == loaded.known_pairs
+    # What neepp view writes (LiveRender.save_visibility_map) under grid_bounds=shading reads back the same way.
+    live = neepp._neepp.LiveRender(neepp.load(DEMO, **SMALL), "path", {"shadow_rays": "neepp", "voxels": "8",
+                                                                       "grid_bounds": "shading"}, 2, "", 0)
+    live.render(2)
+    assert live.save_visibility_map(tmp_path / "view.vis")
+    viewed = neepp.VisibilityMap.load(tmp_path / "view.vis", scene)
+    assert viewed.known_pairs == live.map_info()["known_pairs"] and viewed.bounds == loaded.bounds
+
+
 def test_images_and_metrics(tmp_path):
     rng = np.random.default_rng(1)
     img = rng.random((6, 5, 3), dtype=np.float32)

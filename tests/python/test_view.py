@@ -16,6 +16,7 @@ import signal
 import socket
 import subprocess
 import sys
+import threading
 import time
 from pathlib import Path
 
@@ -282,6 +283,70 @@ def test_live_render_shows_a_pass_under_way():
     between = {f["spp"] for f in frames if not f["within_pass"] and not f["final"]}
     assert {f["spp"] + 1 for f in within} - {4} <= between, (within, between)
     assert frames[-1]["final"] and not frames[-1]["within_pass"] and frames[-1]["spp_mean"] == 4
+
+
+def test_a_moved_views_first_pass_is_shown_over_its_coarse_image():
+    """After a camera move the session shows the coarse image, then, before the first full-resolution pass is
+    complete, frames of that pass's finished tiles over the coarse image (the render loop marks the pixels of
+    the unfinished tiles NaN; the session fills them from the coarse image, enlarged): each 32-pixel tile is
+    either the coarse image's pixels, exactly, or the pass's own, as the frame at the pass's end has them
+    (inside the filter's reach of the tile's edge)."""
+    from neepp_tools.view.session import ViewSession
+    width, height, tile, margin = 256, 144, 32, 3
+    session = ViewSession(neepp.load(DEMO, resx=width, resy=height), "path", {"shadow_rays": "nee"}, max_spp=2,
+                          threads=1, display_interval=0.01)
+    frames = []
+    got = threading.Condition()
+
+    def on_frame(frame):
+        with got:
+            frames.append(frame)
+            got.notify_all()
+
+    def final_of(view):
+        with got:
+            assert got.wait_for(lambda: any(f.view == view and f.stats["final"] and not f.stats["coarse"] for f in frames),
+                                timeout=TIMEOUT)
+
+    session.on_frame = on_frame
+    session.start()
+    try:
+        final_of(0)
+        session.camera_command({"type": "orbit", "dx": 0.1, "dy": 0.02})
+        final_of(1)
+    finally:
+        session.stop()
+    moved = [f for f in frames if f.view == 1]
+    assert moved[0].stats["coarse"] and moved[0].image.shape == (math.ceil(height / 4), math.ceil(width / 4), 3)
+    end = next(i for i, f in enumerate(moved) if not f.stats["coarse"] and not f.stats["within_pass"])
+    assert moved[end].stats["spp"] == 1  # the first pass's end
+    composed = [f for f in moved[1:end] if f.stats["composed"]]
+    assert composed, [f.stats for f in moved[:end + 1]]
+    assert all(f.stats["composed"] == (f.stats["spp"] == 0 and not f.stats["coarse"]) for f in moved)
+    coarse = moved[0].image
+    rows = (2 * np.arange(height) + 1) * coarse.shape[0] // (2 * height)
+    cols = (2 * np.arange(width) + 1) * coarse.shape[1] // (2 * width)
+    enlarged = coarse[rows][:, cols]
+    first_pass = moved[end].image
+    tiles = math.ceil(width / tile) * math.ceil(height / tile)
+    partial = 0
+    for f in composed:
+        image = f.image
+        assert image.shape == (height, width, 3) and np.all(np.isfinite(image))
+        finished = area = 0
+        for ty in range(0, height, tile):
+            for tx in range(0, width, tile):
+                block = (slice(ty, ty + tile), slice(tx, tx + tile))
+                inner = (slice(ty + margin, ty + tile - margin), slice(tx + margin, tx + tile - margin))
+                if np.array_equal(image[block], enlarged[block]):
+                    continue
+                assert np.array_equal(image[inner], first_pass[inner]), (tx, ty)
+                finished += 1
+                area += image[block].shape[0] * image[block].shape[1]
+        assert finished > 0
+        assert f.stats["spp_mean"] == pytest.approx(area / (width * height))
+        partial += finished < tiles
+    assert partial > 0
 
 
 def test_live_render_cancel_stops_at_once():

@@ -2,6 +2,7 @@
 #include <gtest/gtest.h>
 #include <atomic>
 #include <chrono>
+#include <cmath>
 #include <mutex>
 #include <thread>
 #include "neepp/sampling/sampler.h"
@@ -269,6 +270,105 @@ TEST(RenderLoop, ShowsAPassUnderWayAsTheCompletedPassesAndWholeFinishedTiles) {
     // The second pass takes about 2048 samples x 100 us / 2 threads: frames every 5 ms show it under way.
     EXPECT_GE(within, 3);
     EXPECT_GE(partial, 2);
+}
+
+TEST(RenderLoop, ShowsTheFirstPassUnderWayAsItsFinishedTilesAndMarksTheRest) {
+    // RenderJob::display_first_pass: within the first pass, the pixels of its finished tiles are the pass's
+    // image to the bit (a box filter: a pixel is its own samples' mean) and every other pixel is NaN, whole
+    // tiles at a time; spp says no pixel has a sample for sure. The image and its sums stay a plain render's.
+    auto scene = demo_scene(64, 32);
+    scene->settings.rfilter = "box";
+    scene->settings.rfilter_radius = 0.5f;
+    SlowIntegrator integ(std::chrono::microseconds(100));
+    RenderJob job;
+    job.tile_size = 8;
+    job.threads = 2;
+    job.spp = 1;
+    job.keep_state = true;
+    const RenderResult plain = render(*scene, integ, job);  // the first pass alone
+
+    Shown shown;
+    job.on_display = std::ref(shown);
+    job.display_within_pass = true;
+    job.display_first_pass = true;
+    job.display_interval_s = 0.005;
+    const RenderResult r = render(*scene, integ, job);
+    EXPECT_TRUE(r.image.data == plain.image.data);
+    EXPECT_TRUE(r.state.image_sums == plain.state.image_sums);
+
+    const int W = 64, H = 32, T = 8, tiles = (W / T) * (H / T);
+    int within = 0, partial = 0;
+    for (const DisplayFrame &f : shown.frames) {
+        if (!f.within_pass) continue;
+        ++within;
+        EXPECT_EQ(f.spp, 0);
+        int finished = 0;
+        for (int ty = 0; ty < H; ty += T)
+            for (int tx = 0; tx < W; tx += T) {
+                int exact = 0, marked = 0;
+                for (int y = ty; y < ty + T; ++y)
+                    for (int x = tx; x < tx + T; ++x)
+                        for (int c = 0; c < 3; ++c) {
+                            const size_t i = (size_t(y) * W + x) * 3 + c;
+                            exact += f.image.data[i] == plain.image.data[i];
+                            marked += std::isnan(f.image.data[i]);
+                        }
+                EXPECT_TRUE(exact == T * T * 3 || marked == T * T * 3) << "tile " << tx << "," << ty;
+                finished += exact == T * T * 3;
+            }
+        EXPECT_GT(finished, 0);  // a frame comes once a tile is finished, not before
+        EXPECT_EQ(f.spp_max, 1);
+        EXPECT_DOUBLE_EQ(f.spp_mean, double(finished) / tiles);
+        partial += finished < tiles;
+    }
+    // The pass takes about 2048 samples x 100 us / 2 threads: frames every 5 ms show it under way.
+    EXPECT_GE(within, 3);
+    EXPECT_GE(partial, 2);
+
+    // Without display_first_pass nothing is shown before the first pass is complete; nor for a splatting
+    // integrator, whose first pass's splats are known only at its end.
+    Shown without;
+    job.on_display = std::ref(without);
+    job.display_first_pass = false;
+    render(*scene, integ, job);
+    for (const DisplayFrame &f : without.frames) EXPECT_FALSE(f.within_pass);
+    auto light = make_integrator("light", Options(OptionMap{{"shadow_rays", "nee"}}));
+    Shown splatted;
+    job.on_display = std::ref(splatted);
+    job.display_first_pass = true;
+    job.display_interval_s = 0;
+    job.spp = 2;
+    render(*scene, *light, job);
+    for (const DisplayFrame &f : splatted.frames) {
+        EXPECT_GE(f.spp, 1);
+        for (float v : f.image.data) ASSERT_FALSE(std::isnan(v));
+    }
+}
+
+TEST(RenderLoop, FramesWithinAPassAreTheIntervalApartFromStartToStart) {
+    // What a frame within a pass takes (on_display here sleeps 60 ms; on a loaded machine, the wait for a
+    // core) does not add to the display interval: frames 50 ms apart come every 60 ms, where counting the
+    // interval from the end of the last frame made it 110 ms.
+    auto scene = demo_scene(64, 32);
+    SlowIntegrator integ(std::chrono::microseconds(100));
+    RenderJob job;
+    job.tile_size = 8;
+    job.threads = 2;
+    job.spp = 5;  // passes of 1 and 4 spp: about 0.1 s and 0.4 s
+    std::vector<double> starts;
+    job.on_display = [&](DisplayFrame f) {
+        if (!f.within_pass) return;  // (a slow frame between passes is the render's time: shown less often)
+        starts.push_back(f.render_time_s);
+        std::this_thread::sleep_for(std::chrono::milliseconds(60));
+    };
+    job.display_within_pass = true;
+    job.display_interval_s = 0.05;
+    render(*scene, integ, job);
+    ASSERT_GE(starts.size(), 4u);
+    std::vector<double> gaps;
+    for (size_t i = 1; i < starts.size(); ++i) gaps.push_back(starts[i] - starts[i - 1]);
+    std::nth_element(gaps.begin(), gaps.begin() + gaps.size() / 2, gaps.end());
+    EXPECT_LT(gaps[gaps.size() / 2], 0.09);
 }
 
 TEST(RenderLoop, FramesWithinAPassLeaveTheImageAndItsSumsAsTheyAre) {

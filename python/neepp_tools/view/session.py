@@ -4,9 +4,10 @@ One session per server, shared by every page open on it: the camera, the integra
 Each change (a camera move, an option) cancels the render under way at once (LiveRender.cancel) and a
 thread of the session's own renders the new view: first a coarse image (a quarter of the resolution, one
 sample per pixel), then the full image, sent after each pass (a few times a second) as it converges, up to
-the most samples per pixel a view gets. Within a pass, once a first is complete, the image is sent too
-(the completed passes with the tiles of the running pass that are finished), so that it moves on about ten
-times a second however long a pass of the scene takes. The integrator is kept across camera moves, so
+the most samples per pixel a view gets. Within a pass the image is sent too (the completed passes with the
+tiles of the running pass that are finished), so that it moves on about ten times a second however long a
+pass of the scene takes; within the first pass, whose unfinished tiles have no sample yet, the finished
+tiles are shown over the coarse image (stats["composed"]). The integrator is kept across camera moves, so
 NEE++'s visibility map, which belongs to the scene and not to the view, keeps learning from every view; a
 new integrator or new options start it afresh.
 
@@ -75,6 +76,7 @@ class ViewSession:
         self.last_saved: Optional[Frame] = None
         self._stopping = False
         self.latest: Optional[Frame] = None  # the newest full-resolution image, for save
+        self._coarse: Optional[Frame] = None  # the coarse image of the view in render, under its first pass
         self.view_in_render, self.camera_in_render = -1, {"to_world": self.camera.to_world(), "fov": self.camera.fov}
         # Called from the render thread: with each frame, and with each message for every page.
         self.on_frame: Callable[[Frame], None] = lambda frame: None
@@ -260,8 +262,9 @@ class ViewSession:
                 if self.preview and self._current(view):
                     self.live.render(1, PREVIEW_SCALE, 1.0, lambda im, info: self._frame(view, camera, im, info, True))
                 if self._current(view):
+                    # The first pass under way too, where its finished tiles can go over a coarse image.
                     self.live.render(self.max_spp, 1, self.display_interval,
-                                     lambda im, info: self._frame(view, camera, im, info, False))
+                                     lambda im, info: self._frame(view, camera, im, info, False), self.preview)
             except Exception as e:  # a render the integrator refuses (bdpt on a thin lens...): said, not fatal
                 self.on_message({"type": "error", "message": str(e)})
             self._answer_requests()
@@ -286,10 +289,16 @@ class ViewSession:
             self._answer_requests()  # between passes: the map holds still (within one it is learning)
         if not self._current(view):  # a cancelled render's last image: of a view no longer shown
             return
+        composed = not coarse and info["within_pass"] and info["spp"] == 0
+        if composed:  # the first pass under way: its unfinished tiles (NaN) show the coarse image
+            if self._coarse is None or self._coarse.view != view:
+                return
+            image = over_coarse(image, self._coarse.image)
         t = info["render_time_s"]
         # Within a pass the tiles it finished have more samples than the others: spp is the fewest a pixel
         # has, spp_max the most, spp_mean their mean (the samples in the image).
-        stats = {**info, "view": view, "coarse": coarse, "integrator": self.integrator, "options": self.options(),
+        stats = {**info, "view": view, "coarse": coarse, "composed": composed, "integrator": self.integrator,
+                 "options": self.options(),
                  "samples_per_s": info["spp_mean"] * info["width"] * info["height"] / t if t > 0 else 0.0, **camera}
         reference = self.reference
         if not coarse and reference is not None and reference.shape == image.shape:
@@ -297,7 +306,9 @@ class ViewSession:
             stats["relmse"] = relmse(image, reference)
             stats["reference"] = self.reference_name
         frame = Frame(view, image, stats)
-        if not coarse:
+        if coarse:
+            self._coarse = frame
+        elif not composed:  # save writes a rendered image, not one partly the coarse image
             self.latest = frame
         self.on_frame(frame)
 
@@ -333,3 +344,15 @@ class ViewSession:
         self.last_saved = frame
         suffixes = (".exr", ".png", ".json") + ((".vis",) if map_info is not None else ())
         return [str(base.with_suffix(s)) for s in suffixes]
+
+
+def over_coarse(image: np.ndarray, coarse: np.ndarray) -> np.ndarray:
+    """A frame within the first pass ((H, W, 3), NaN in the pixels of its unfinished tiles) with those pixels
+    taken from the coarse image of the view, enlarged: each from the coarse pixel its centre falls in (both
+    images span the same field of view)."""
+    missing = np.isnan(image[..., 0])
+    ys, xs = np.nonzero(missing)
+    height, width = missing.shape
+    out = image if image.flags.writeable else image.copy()
+    out[ys, xs] = coarse[(2 * ys + 1) * coarse.shape[0] // (2 * height), (2 * xs + 1) * coarse.shape[1] // (2 * width)]
+    return out

@@ -87,6 +87,21 @@ PassStatistics pass_statistics(int pass_index, int spp, int pass_size, const std
 }
 
 
+// A frame within the first pass: NaN in every pixel outside the finished tiles, which has no sample of its
+// own yet (one beside a finished tile has that tile's share through the filter's border, but from one side
+// only: not an estimate of the pixel).
+void mark_unsampled(Image &image, const std::vector<Tile> &tiles, const std::vector<size_t> &finished) {
+    std::vector<uint8_t> sampled(size_t(image.width) * image.height, 0);
+    for (size_t i : finished) {
+        const Tile &t = tiles[i];
+        for (int y = t.y0; y < t.y0 + t.h; ++y)
+            std::fill_n(sampled.begin() + ptrdiff_t(size_t(y) * image.width + t.x0), t.w, uint8_t(1));
+    }
+    const float nan = std::numeric_limits<float>::quiet_NaN();
+    for (size_t i = 0; i < sampled.size(); ++i)
+        if (!sampled[i]) std::fill_n(image.data.begin() + ptrdiff_t(3 * i), 3, nan);
+}
+
 // The image: the accumulated samples plus the splat layer (if any), scaled by pixels / light paths.
 Image combine_layers(const ImageBlock &samples, const SplatFilm *splats, double light_paths, double splat_scale) {
     Image image = samples.resolve();
@@ -293,6 +308,9 @@ private:
     double one_off_s_ = 0;  // seconds of the pass spent on one-off work (PSSMLT's bootstrap)
     double seconds_per_spp_ = 0;
     double last_checkpoint_ = 0, last_snapshot_ = 0;
+    // When the last frame shown began: frames are display_wait_ apart from start to start, so that what a
+    // frame takes (its image resolved, on_display, on a loaded machine the wait for a core) does not add to
+    // the interval.
     double last_display_ = -std::numeric_limits<double>::infinity();  // the first pass is shown
     double display_wait_ = 0;
     RenderResult result_;
@@ -304,6 +322,7 @@ private:
     // lock of the display's and never wait for it; the render's thread takes pass_state_mutex_ at a pass's
     // start and end only (the display thread holds it while it copies the image, a few milliseconds).
     const bool display_within_pass_;
+    const bool display_first_pass_;  // RenderJob::display_first_pass, where it applies
     std::vector<std::unique_ptr<ImageBlock>> tile_blocks_;
     std::unique_ptr<std::atomic<bool>[]> tile_published_;
     std::atomic<size_t> tiles_published_{0};
@@ -341,7 +360,8 @@ RenderLoop::RenderLoop(const Scene &scene, Integrator &integrator, const RenderJ
       pool_(size_t(threads_)), arena_(threads_), budget_(job),
       cpu_start_(cpu_seconds(CpuClock::process)),
       // PSSMLT's pass body has no tiles: its image is all of its chains' splats, known only at the pass's end.
-      display_within_pass_(job.display_within_pass && bool(job.on_display) && !passes_) {
+      display_within_pass_(job.display_within_pass && bool(job.on_display) && !passes_),
+      display_first_pass_(display_within_pass_ && job.display_first_pass && !splatting_) {
     border_ = int(std::ceil(filter_.radius() - 0.5f));
     if (splatting_) {
         splats_accumulated_ = std::make_unique<SplatFilm>(W_, H_, &filter_);
@@ -572,10 +592,10 @@ void RenderLoop::show_between_passes() {
     job_.on_display(DisplayFrame{current_image(), result_.spp, budget_.elapsed(), counted(), false, result_.spp,
                                  double(result_.spp), false});
     shown_passes_ = result_.passes;
-    last_display_ = budget_.elapsed();
+    last_display_ = start;
     // Resolving the image is the render's time: a large image is shown less often, so that it costs at most
     // about 5 % of the render.
-    display_wait_ = std::max(job_.display_interval_s, 20 * (last_display_ - start));
+    display_wait_ = std::max(job_.display_interval_s, 20 * (budget_.elapsed() - start));
 }
 
 std::optional<DisplayFrame> RenderLoop::frame_within_pass(int &pass, size_t &tiles_shown) {
@@ -583,12 +603,14 @@ std::optional<DisplayFrame> RenderLoop::frame_within_pass(int &pass, size_t &til
     Image splat;
     DisplayFrame frame;
     uint64_t pixels_ahead = 0;  // pixels with the running pass's samples
+    std::vector<size_t> finished;  // within the first pass: the tiles whose pixels have a sample
+    bool first_pass = false;
     {
         const std::lock_guard<std::mutex> lock(pass_state_mutex_);
         const PassState &p = pass_state_;
-        // Before the first pass is complete, a pixel of a tile not yet finished has no sample at all: the
-        // frame would be black there, a worse picture than none (neepp view shows its coarse image then).
-        if (!p.running || p.passes == 0) return std::nullopt;
+        // Before the first pass is complete, a pixel of a tile not yet finished has no sample at all: shown
+        // only to a caller that asked for it, which is told which pixels those are (NaN).
+        if (!p.running || (p.passes == 0 && !display_first_pass_)) return std::nullopt;
         if (tiles_published_.load(std::memory_order_acquire) == (p.passes == pass ? tiles_shown : 0)) return std::nullopt;
         samples.emplace(accumulated_);
         size_t tiles = 0;
@@ -597,7 +619,9 @@ std::optional<DisplayFrame> RenderLoop::frame_within_pass(int &pass, size_t &til
                 samples->merge(*tile_blocks_[i]);
                 pixels_ahead += uint64_t(tiles_[i].w) * tiles_[i].h;
                 ++tiles;
+                if (p.passes == 0) finished.push_back(i);
             }
+        first_pass = p.passes == 0;
         if (p.passes == pass && tiles == tiles_shown) return std::nullopt;
         pass = p.passes;
         tiles_shown = tiles;
@@ -615,6 +639,7 @@ std::optional<DisplayFrame> RenderLoop::frame_within_pass(int &pass, size_t &til
         frame.counters = p.counted;
     }
     frame.image = samples->resolve();
+    if (first_pass) mark_unsampled(frame.image, tiles_, finished);
     if (!splat.data.empty())
         for (size_t i = 0; i < frame.image.data.size(); ++i) frame.image.data[i] += splat.data[i];
     frame.render_time_s = budget_.elapsed();
@@ -635,6 +660,7 @@ void RenderLoop::display_within_passes() {
             continue;
         }
         lock.unlock();
+        const double start = budget_.elapsed();
         const double cpu_start = cpu_seconds(CpuClock::thread);
         std::optional<DisplayFrame> frame = frame_within_pass(pass, tiles_shown);
         lock.lock();
@@ -652,7 +678,7 @@ void RenderLoop::display_within_passes() {
             display_error_ = std::current_exception();
             return;
         }
-        last_display_ = budget_.elapsed();
+        last_display_ = start;
         // What a frame costs the render is the CPU time it takes from the workers (the image copied and
         // resolved, on_display): at most about 5 % of a core. Not its wall time, which on a machine that the
         // workers keep busy is mostly theirs.

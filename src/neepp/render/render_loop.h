@@ -19,7 +19,9 @@ class Integrator;
 // What a live view of the render is shown (RenderJob::on_display): the image so far and what made it.
 // Within a pass (RenderJob::display_within_pass) the pixels of the tiles the pass has finished have its
 // samples too, the others not yet: spp is what every pixel has, spp_max what the most have, spp_mean the
-// mean over the pixels; between passes the three are equal.
+// mean over the pixels; between passes the three are equal. Within the first pass (RenderJob::
+// display_first_pass) spp is 0, and the pixels of the tiles not finished yet, which have no sample at all,
+// are NaN.
 struct DisplayFrame {
     Image image;
     int spp = 0;                // samples per pixel that every pixel of the image has
@@ -70,6 +72,11 @@ struct RenderJob {
     // on_display is then called from a second thread of the render's own too (never at once with the
     // first), and each tile's samples are kept until the pass ends (about 32 more bytes per pixel).
     bool display_within_pass = false;
+    // With display_within_pass, show the first pass under way too: its finished tiles, and NaN in the pixels
+    // of the others (no sample has reached them). For a caller that has something of its own to show there
+    // (neepp view fills them from its coarse image of the view); a plain viewer would show holes. Not for a
+    // splatting integrator: the first pass's splats are normalised by its light paths, counted at its end.
+    bool display_first_pass = false;
     // 0: passes as large as the render loop likes (up to 32 spp). An interactive view (neepp view) sets
     // about its display interval: each pass then takes about that long at the last pass's speed (at least
     // one sample per pixel), so that the image can be shown that often.

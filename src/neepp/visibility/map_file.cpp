@@ -14,6 +14,22 @@ namespace {
 constexpr char kMagic[8] = {'N', 'E', 'E', 'P', 'P', 'V', 'I', 'S'};
 constexpr uint32_t kVersion = 1;
 
+// Magic, version and checksum, before anything else is read: a damaged file must not be read any further,
+// whatever the damage.
+void check_envelope(const std::string &bytes, const std::string &what) {
+    auto fail = [&](const std::string &why) { return std::runtime_error(fmt::format("{}: {}", what, why)); };
+    if (bytes.size() < 8 || std::memcmp(bytes.data(), kMagic, 8) != 0) throw fail("not a neepp visibility map (bad magic)");
+    if (bytes.size() < 8 + 4 + 8) throw fail("file is truncated");
+    uint64_t stored;
+    std::memcpy(&stored, bytes.data() + bytes.size() - 8, 8);
+    uint64_t actual = fnv1a64(bytes.data(), bytes.size() - 8);
+    BinaryReader r{bytes, 8, what};
+    uint32_t version = r.get<uint32_t>();
+    if (version != kVersion) throw fail(fmt::format("unsupported version {} (this build reads version {})", version, kVersion));
+    if (stored != actual)
+        throw fail(fmt::format("checksum mismatch (stored {:016x}, computed {:016x}): the file is damaged", stored, actual));
+}
+
 }  // namespace
 
 uint64_t scene_fingerprint(const Scene &scene) {
@@ -100,20 +116,16 @@ VisibilityMap load_visibility_map(const std::string &path, const VoxelGrid &grid
     return decode_visibility_map(read_file_bytes(path, what), what, grid, fingerprint);
 }
 
+std::pair<VoxelGrid, VisibilityMap> load_visibility_map(const std::string &path, uint64_t fingerprint) {
+    const std::string what = fmt::format("visibility map '{}'", path);
+    return decode_visibility_map(read_file_bytes(path, what), what, fingerprint);
+}
+
 VisibilityMap decode_visibility_map(const std::string &bytes, const std::string &what, const VoxelGrid &grid,
                                     uint64_t fingerprint) {
     auto fail = [&](const std::string &why) { return std::runtime_error(fmt::format("{}: {}", what, why)); };
-    if (bytes.size() < 8 || std::memcmp(bytes.data(), kMagic, 8) != 0) throw fail("not a neepp visibility map (bad magic)");
-    if (bytes.size() < 8 + 4 + 8) throw fail("file is truncated");
-    // Checksum first: a damaged file must not be read any further, whatever the damage.
-    uint64_t stored;
-    std::memcpy(&stored, bytes.data() + bytes.size() - 8, 8);
-    uint64_t actual = fnv1a64(bytes.data(), bytes.size() - 8);
-    BinaryReader r{bytes, 8, what};
-    uint32_t version = r.get<uint32_t>();
-    if (version != kVersion) throw fail(fmt::format("unsupported version {} (this build reads version {})", version, kVersion));
-    if (stored != actual)
-        throw fail(fmt::format("checksum mismatch (stored {:016x}, computed {:016x}): the file is damaged", stored, actual));
+    check_envelope(bytes, what);
+    BinaryReader r{bytes, 8 + 4, what};
     uint32_t n = r.get<uint32_t>(), bins = r.get<uint32_t>();
     Vec3 lo = r.get<Vec3>(), hi = r.get<Vec3>();
     uint64_t fp = r.get<uint64_t>(), entries = r.get<uint64_t>();
@@ -142,7 +154,8 @@ VisibilityMap decode_visibility_map(const std::string &bytes, const std::string 
 std::pair<VoxelGrid, VisibilityMap> decode_visibility_map(const std::string &bytes, const std::string &what,
                                                           uint64_t fingerprint) {
     // The header's grid (after magic and version: resolution, bins, bounds); the full decode checks the rest.
-    BinaryReader r{bytes, std::min<size_t>(bytes.size(), 8 + 4), what};
+    check_envelope(bytes, what);
+    BinaryReader r{bytes, 8 + 4, what};
     const uint32_t n = r.get<uint32_t>();
     r.get<uint32_t>();
     const Vec3 lo = r.get<Vec3>(), hi = r.get<Vec3>();

@@ -36,6 +36,9 @@ void save_visibility_map(const std::string &path, const VoxelGrid &grid, const V
 // (resolution and bounds) and this scene (fingerprint). Throws std::runtime_error naming the file and
 // the mismatch otherwise.
 VisibilityMap load_visibility_map(const std::string &path, const VoxelGrid &grid, uint64_t fingerprint);
+// The same with the grid the file was written for (its resolution and bounds: the scene's, or those of a
+// grid_bounds=shading render, which depend on the camera and cannot be known without the file).
+std::pair<VoxelGrid, VisibilityMap> load_visibility_map(const std::string &path, uint64_t fingerprint);
 
 // The same in memory (a render checkpoint carries a map): the file's bytes, and their checked reading,
 // whose errors start with `what`.

@@ -191,7 +191,8 @@ function percent(part, whole) {
 function showStats(h) {
   const tested = h.shadow_rays + h.shadow_rays_skipped;
   const text = {
-    view: h.view + (h.coarse ? " (coarse)" : ""),
+    // Within the first full pass its finished tiles are drawn over the coarse image.
+    view: h.view + (h.coarse ? " (coarse)" : h.composed ? " (tiles over the coarse)" : ""),
     // Within a pass the tiles it finished have its samples too.
     spp: h.spp_max > h.spp ? `${h.spp}–${h.spp_max} (mean ${h.spp_mean.toFixed(2)})` : String(h.spp),
     samples_per_s: formatCount(h.samples_per_s),
