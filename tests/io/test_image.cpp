@@ -1,6 +1,9 @@
 #include <gtest/gtest.h>
 
+#include <atomic>
 #include <cmath>
+#include <cstdlib>
+#include <new>
 #include <cstring>
 #include <iterator>
 #include <sys/resource.h>
@@ -205,6 +208,84 @@ TEST(Image, ExrDataWindowIsCappedBeforeThePixelsAreRead) {
     EXPECT_NE(msg.find(path), std::string::npos) << msg;
     EXPECT_NE(msg.find("(read)"), 0u) << msg;
     EXPECT_LT(after.ru_maxrss - before.ru_maxrss, 256 * 1024) << "kB grown: " << after.ru_maxrss - before.ru_maxrss;
+    EXPECT_EQ(message(good), "(read)");
+    std::filesystem::remove(path);
+}
+
+// The largest operator new[] of this test program while counting is on: OpenEXR allocates a header
+// attribute's value with new char[size], so the test below can see whether a claimed size was allocated.
+namespace {
+std::atomic<bool> counting_new{false};
+std::atomic<size_t> largest_new{0};
+}  // namespace
+
+void *operator new[](std::size_t n) {
+    if (counting_new.load(std::memory_order_relaxed) && n > largest_new.load(std::memory_order_relaxed))
+        largest_new.store(n, std::memory_order_relaxed);
+    if (void *p = std::malloc(n ? n : 1)) return p;
+    throw std::bad_alloc();
+}
+void operator delete[](void *p) noexcept { std::free(p); }
+void operator delete[](void *p, std::size_t) noexcept { std::free(p); }
+
+namespace {
+
+// A one-chunk OpenEXR file's bytes with an attribute (name, type name, claimed size, then the bytes given)
+// added at the start of its header, right after the magic number and version, and its chunk offset table
+// (one offset, pointing right behind itself) moved along.
+std::string with_attribute(const std::string &bytes, const std::string &name, const std::string &type, int32_t size,
+                           const std::string &value) {
+    std::string attribute = name + '\0' + type + '\0';
+    attribute.append(reinterpret_cast<const char *>(&size), 4);  // little-endian, as the file is
+    attribute += value;
+    std::string out = bytes.substr(0, 8) + attribute + bytes.substr(8);
+    for (size_t at = 8; at + 8 <= bytes.size(); ++at) {
+        uint64_t offset;
+        std::memcpy(&offset, &bytes[at], 8);
+        if (offset != at + 8) continue;
+        offset += attribute.size();
+        std::memcpy(&out[at + attribute.size()], &offset, 8);
+        return out;
+    }
+    throw std::logic_error("no chunk offset table in the EXR file");
+}
+
+}  // namespace
+
+// OpenEXR allocates an attribute's value at the size its header claims before reading it (an unknown
+// type's as new char[size], up to 2 GB; a string's zero-filled): an attribute claiming more
+// than the file holds is refused from the header, naming the file, the attribute and the size, before
+// OpenEXR allocates it (the fuzzer met such headers at 78 % of its time).
+TEST(Image, ExrAttributeSizesAreCheckedBeforeOpenExrAllocatesThem) {
+    const std::string path = temp_path("attribute.exr");
+    write_exr(path, ramp(4, 3, 3));
+    const std::string good = read_bytes(path);
+    auto message = [&](const std::string &bytes) {
+        std::ofstream(path, std::ios::binary | std::ios::trunc) << bytes;
+        largest_new = 0;
+        counting_new = true;
+        std::string msg = "(read)";
+        try {
+            read_image(path);
+        } catch (const std::exception &e) {
+            msg = e.what();
+        }
+        counting_new = false;
+        return msg;
+    };
+    // A small attribute of an unknown type that the file does hold is read (OpenEXR keeps it opaque).
+    EXPECT_EQ(message(with_attribute(good, "note", "neeppnote", 5, "hello")), "(read)");
+    for (int32_t size : {2000000000, -7, 4096}) {
+        const std::string msg = message(with_attribute(good, "note", "neeppnote", size, "hello"));
+        EXPECT_NE(msg.find(path), std::string::npos) << msg;
+        EXPECT_NE(msg.find("'note'"), std::string::npos) << msg;
+        EXPECT_NE(msg.find(std::to_string(size) + " bytes"), std::string::npos) << msg;
+        EXPECT_LT(largest_new.load(), size_t(1) << 20) << size << ": " << msg;
+    }
+    // A known type's attribute (a string) claiming more than the file holds.
+    const std::string msg = message(with_attribute(good, "owner", "string", 100000000, "me"));
+    EXPECT_NE(msg.find("'owner'"), std::string::npos) << msg;
+    EXPECT_NE(msg.find("100000000 bytes"), std::string::npos) << msg;
     EXPECT_EQ(message(good), "(read)");
     std::filesystem::remove(path);
 }
