@@ -283,9 +283,20 @@ TEST(Image, ExrAttributeSizesAreCheckedBeforeOpenExrAllocatesThem) {
         EXPECT_LT(largest_new.load(), size_t(1) << 20) << size << ": " << msg;
     }
     // A known type's attribute (a string) claiming more than the file holds.
-    const std::string msg = message(with_attribute(good, "owner", "string", 100000000, "me"));
+    std::string msg = message(with_attribute(good, "owner", "string", 100000000, "me"));
     EXPECT_NE(msg.find("'owner'"), std::string::npos) << msg;
     EXPECT_NE(msg.find("100000000 bytes"), std::string::npos) << msg;
+    // OpenEXR reads a channel list up to its empty name and an int as 4 bytes, whatever their size fields
+    // say: the attribute after such a one is where OpenEXR reads it, and is checked there.
+    const std::string huge = with_attribute(good, "note", "neeppnote", 2000000000, "hello");
+    const std::string channel = std::string("Q\0", 2) + std::string(16, '\1') + '\0';
+    for (const std::string &bytes : {with_attribute(huge, "pad", "int", 1000000, "abcd"),
+                                     with_attribute(huge, "more", "chlist", 3, channel)}) {
+        msg = message(bytes);
+        EXPECT_NE(msg.find("'note'"), std::string::npos) << msg;
+        EXPECT_LT(largest_new.load(), size_t(1) << 20) << msg;
+    }
+    EXPECT_EQ(message(with_attribute(good, "pad", "int", 1000000, "abcd")), "(read)");
     EXPECT_EQ(message(good), "(read)");
     std::filesystem::remove(path);
 }
