@@ -300,3 +300,39 @@ TEST(Image, ExrAttributeSizesAreCheckedBeforeOpenExrAllocatesThem) {
     EXPECT_EQ(message(good), "(read)");
     std::filesystem::remove(path);
 }
+
+// stb_image grows its buffer for a PNG's IDAT data to the size each chunk claims (up to 2 GB) before it
+// reads the chunk: a chunk claiming more than the file holds is refused first, naming the file, the chunk
+// and the size.
+TEST(Image, PngChunkLengthsAreCheckedBeforeTheyAreRead) {
+    const std::string path = temp_path("chunk.png");
+    write_png_srgb(path, ramp(4, 3, 3));
+    const std::string good = read_bytes(path);
+    const size_t idat = good.find("IDAT");
+    ASSERT_NE(idat, std::string::npos);
+    auto message = [&](const std::string &bytes) {
+        std::ofstream(path, std::ios::binary | std::ios::trunc) << bytes;
+        try {
+            read_image(path);
+        } catch (const std::exception &e) {
+            return std::string(e.what());
+        }
+        return std::string("(read)");
+    };
+    EXPECT_EQ(message(good), "(read)");
+    for (uint32_t length : {0x7fff0000u, 0xfffffff0u, 5000u}) {
+        std::string bad = good;
+        for (int i = 0; i < 4; ++i) bad[idat - 4 + i] = char(length >> (24 - 8 * i));  // big-endian
+        const std::string msg = message(bad);
+        EXPECT_NE(msg.find(path), std::string::npos) << msg;
+        EXPECT_NE(msg.find("chunk 'IDAT' claims " + std::to_string(length) + " bytes"), std::string::npos) << msg;
+        bool bytes_msg = false;
+        try {
+            read_image_bytes(path);
+        } catch (const std::exception &e) {
+            bytes_msg = std::string(e.what()).find("'IDAT'") != std::string::npos;
+        }
+        EXPECT_TRUE(bytes_msg) << length;
+    }
+    std::filesystem::remove(path);
+}
