@@ -1,3 +1,25 @@
+#include <ImfBoxAttribute.h>
+#include <ImfChannelList.h>
+#include <ImfChromaticitiesAttribute.h>
+#include <ImfDeepImageStateAttribute.h>
+#include <ImfDoubleAttribute.h>
+#include <ImfEnvmapAttribute.h>
+#include <ImfFloatAttribute.h>
+#include <ImfFloatVectorAttribute.h>
+#include <ImfFrameBuffer.h>
+#include <ImfHeader.h>
+#include <ImfIntAttribute.h>
+#include <ImfKeyCodeAttribute.h>
+#include <ImfMatrixAttribute.h>
+#include <ImfOutputFile.h>
+#include <ImfPreviewImageAttribute.h>
+#include <ImfRationalAttribute.h>
+#include <ImfStringAttribute.h>
+#include <ImfStringVectorAttribute.h>
+#include <ImfTileDescriptionAttribute.h>
+#include <ImfTiledOutputFile.h>
+#include <ImfTimeCodeAttribute.h>
+#include <ImfVecAttribute.h>
 #include <gtest/gtest.h>
 
 #include <atomic>
@@ -335,4 +357,68 @@ TEST(Image, PngChunkLengthsAreCheckedBeforeTheyAreRead) {
         EXPECT_TRUE(bytes_msg) << length;
     }
     std::filesystem::remove(path);
+}
+
+// The header walk that checks attribute sizes steps over each known type at the size OpenEXR reads: a
+// file with an attribute of every type OpenEXR 3.1 knows (and several of the sized ones) reads, as
+// scan lines and as mipmapped tiles, so a wrong size in the walk's table would show as a refused file.
+TEST(Image, ExrWithAttributesOfEveryTypeReads) {
+    const Image img = ramp(5, 3, 3);
+    Imf::Header header(img.width, img.height);
+    header.insert("b2f", Imf::Box2fAttribute(Imath::Box2f(Imath::V2f(0.f, 1.f), Imath::V2f(2.f, 3.f))));
+    header.insert("chroma", Imf::ChromaticitiesAttribute(Imf::Chromaticities()));
+    header.insert("deep", Imf::DeepImageStateAttribute(Imf::DIS_TIDY));
+    header.insert("dbl", Imf::DoubleAttribute(2.5));
+    header.insert("env", Imf::EnvmapAttribute(Imf::ENVMAP_LATLONG));
+    header.insert("flt", Imf::FloatAttribute(1.5f));
+    header.insert("fv", Imf::FloatVectorAttribute(Imf::FloatVector{1.f, 2.f, 3.f}));
+    header.insert("num", Imf::IntAttribute(7));
+    header.insert("key", Imf::KeyCodeAttribute(Imf::KeyCode(1, 2, 3, 4, 5, 4, 64)));
+    header.insert("m33d", Imf::M33dAttribute(Imath::M33d()));
+    header.insert("m33f", Imf::M33fAttribute(Imath::M33f()));
+    header.insert("m44d", Imf::M44dAttribute(Imath::M44d()));
+    header.insert("m44f", Imf::M44fAttribute(Imath::M44f()));
+    header.insert("preview", Imf::PreviewImageAttribute(Imf::PreviewImage(3, 2)));
+    header.insert("rat", Imf::RationalAttribute(Imf::Rational(24000, 1001)));
+    header.insert("owner", Imf::StringAttribute("neepp"));
+    header.insert("sv", Imf::StringVectorAttribute(Imf::StringVector{"a", "", "bcd"}));
+    header.insert("td", Imf::TileDescriptionAttribute(Imf::TileDescription(8, 8, Imf::MIPMAP_LEVELS)));
+    header.insert("tc", Imf::TimeCodeAttribute(Imf::TimeCode(1, 2, 3, 4)));
+    header.insert("v2d", Imf::V2dAttribute(Imath::V2d(1., 2.)));
+    header.insert("v2f", Imf::V2fAttribute(Imath::V2f(1.f, 2.f)));
+    header.insert("v2i", Imf::V2iAttribute(Imath::V2i(1, 2)));
+    header.insert("v3d", Imf::V3dAttribute(Imath::V3d(1., 2., 3.)));
+    header.insert("v3f", Imf::V3fAttribute(Imath::V3f(1.f, 2.f, 3.f)));
+    header.insert("v3i", Imf::V3iAttribute(Imath::V3i(1, 2, 3)));
+    const char *names[] = {"R", "G", "B"};
+    for (const char *n : names) header.channels().insert(n, Imf::Channel(Imf::FLOAT));
+    const size_t xstride = sizeof(float) * 3, ystride = xstride * img.width;
+    Imf::FrameBuffer fb;
+    for (int c = 0; c < 3; ++c)
+        fb.insert(names[c], Imf::Slice(Imf::FLOAT, (char *)(img.data.data() + c), xstride, ystride));
+    const std::string scanlines = temp_path("attributes.exr"), tiles = temp_path("attributes_tiled.exr");
+    {
+        Imf::OutputFile file(scanlines.c_str(), header);
+        file.setFrameBuffer(fb);
+        file.writePixels(img.height);
+    }
+    {
+        Imf::Header tiled = header;
+        tiled.setTileDescription(Imf::TileDescription(2, 2, Imf::MIPMAP_LEVELS));
+        Imf::TiledOutputFile file(tiles.c_str(), tiled);
+        file.setFrameBuffer(fb);
+        for (int level = 0; level < file.numLevels(); ++level)  // each level's pixels: level 0's corner
+            file.writeTiles(0, file.numXTiles(level) - 1, 0, file.numYTiles(level) - 1, level);
+    }
+    for (const std::string &path : {scanlines, tiles}) {
+        Image back;
+        try {
+            back = read_image(path);
+        } catch (const std::exception &e) {
+            FAIL() << e.what();
+        }
+        EXPECT_EQ(back.width, img.width);
+        EXPECT_EQ(back.data, img.data) << path;
+        std::filesystem::remove(path);
+    }
 }
