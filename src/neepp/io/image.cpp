@@ -76,6 +76,32 @@ ImageBytes read_jpeg(const std::string &path) {
     jpeg_create_decompress(&cinfo);
     jpeg_stdio_src(&cinfo, f.get());
     jpeg_read_header(&cinfo, TRUE);
+    // libjpeg decodes a file that ends early with a warning, the rest gray, so a damaged header asking for
+    // a huge image from a few bytes costs all its pixels (fuzz_image met a 199-byte file asking for
+    // 16725x21334 RGB: 1 GB of codes, 4 GB as floats). With Huffman coding each 8x8 block of each
+    // component takes at least one bit (its DC code), so a complete file holds at least one byte per 8
+    // blocks: one asking for more blocks is refused before libjpeg allocates anything for them.
+    // Arithmetic coding has no such floor and is left alone.
+    if (!cinfo.arith_code) {
+        std::error_code ec;
+        const uintmax_t file_size = std::filesystem::file_size(path, ec);
+        uint64_t blocks = 0;
+        for (int c = 0; c < cinfo.num_components; ++c) {
+            const jpeg_component_info &comp = cinfo.comp_info[c];
+            const uint64_t w = (uint64_t(cinfo.image_width) * comp.h_samp_factor + 8 * cinfo.max_h_samp_factor - 1) /
+                               (8 * uint64_t(std::max(1, cinfo.max_h_samp_factor)));
+            const uint64_t h = (uint64_t(cinfo.image_height) * comp.v_samp_factor + 8 * cinfo.max_v_samp_factor - 1) /
+                               (8 * uint64_t(std::max(1, cinfo.max_v_samp_factor)));
+            blocks += w * h;
+        }
+        if (!ec && blocks > 8 * uint64_t(file_size)) {
+            jpeg_destroy_decompress(&cinfo);
+            fail(path, fmt::format("its JPEG header asks for {}x{} pixels of {} components ({} blocks of 8x8), "
+                                   "more than its {} bytes can hold (at least one bit a block): a damaged header or "
+                                   "a truncated file",
+                                   cinfo.image_width, cinfo.image_height, cinfo.num_components, blocks, file_size));
+        }
+    }
     jpeg_start_decompress(&cinfo);
     const int w = int(cinfo.output_width), h = int(cinfo.output_height), n = cinfo.output_components;
     if (n != 1 && n != 3) {
