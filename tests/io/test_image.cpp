@@ -1,6 +1,31 @@
+#include <ImfBoxAttribute.h>
+#include <ImfChannelList.h>
+#include <ImfChromaticitiesAttribute.h>
+#include <ImfDeepImageStateAttribute.h>
+#include <ImfDoubleAttribute.h>
+#include <ImfEnvmapAttribute.h>
+#include <ImfFloatAttribute.h>
+#include <ImfFloatVectorAttribute.h>
+#include <ImfFrameBuffer.h>
+#include <ImfHeader.h>
+#include <ImfIntAttribute.h>
+#include <ImfKeyCodeAttribute.h>
+#include <ImfMatrixAttribute.h>
+#include <ImfOutputFile.h>
+#include <ImfPreviewImageAttribute.h>
+#include <ImfRationalAttribute.h>
+#include <ImfStringAttribute.h>
+#include <ImfStringVectorAttribute.h>
+#include <ImfTileDescriptionAttribute.h>
+#include <ImfTiledOutputFile.h>
+#include <ImfTimeCodeAttribute.h>
+#include <ImfVecAttribute.h>
 #include <gtest/gtest.h>
 
+#include <atomic>
 #include <cmath>
+#include <cstdlib>
+#include <new>
 #include <cstring>
 #include <iterator>
 #include <sys/resource.h>
@@ -206,5 +231,232 @@ TEST(Image, ExrDataWindowIsCappedBeforeThePixelsAreRead) {
     EXPECT_NE(msg.find("(read)"), 0u) << msg;
     EXPECT_LT(after.ru_maxrss - before.ru_maxrss, 256 * 1024) << "kB grown: " << after.ru_maxrss - before.ru_maxrss;
     EXPECT_EQ(message(good), "(read)");
+    std::filesystem::remove(path);
+}
+
+// The largest operator new[] of this test program while counting is on: OpenEXR allocates a header
+// attribute's value with new char[size], so the test below can see whether a claimed size was allocated.
+namespace {
+std::atomic<bool> counting_new{false};
+std::atomic<size_t> largest_new{0};
+}  // namespace
+
+void *operator new[](std::size_t n) {
+    if (counting_new.load(std::memory_order_relaxed) && n > largest_new.load(std::memory_order_relaxed))
+        largest_new.store(n, std::memory_order_relaxed);
+    if (void *p = std::malloc(n ? n : 1)) return p;
+    throw std::bad_alloc();
+}
+// The nothrow form too, so that every delete[] (replaced below) frees what malloc gave (AddressSanitizer
+// reports a mismatch otherwise: libstdc++'s ios_base allocates with new[](n, nothrow)).
+void *operator new[](std::size_t n, const std::nothrow_t &) noexcept { return std::malloc(n ? n : 1); }
+void operator delete[](void *p) noexcept { std::free(p); }
+void operator delete[](void *p, std::size_t) noexcept { std::free(p); }
+void operator delete[](void *p, const std::nothrow_t &) noexcept { std::free(p); }
+
+namespace {
+
+// A one-chunk OpenEXR file's bytes with an attribute (name, type name, claimed size, then the bytes given)
+// added at the start of its header, right after the magic number and version, and its chunk offset table
+// (one offset, pointing right behind itself) moved along.
+std::string with_attribute(const std::string &bytes, const std::string &name, const std::string &type, int32_t size,
+                           const std::string &value) {
+    std::string attribute = name + '\0' + type + '\0';
+    attribute.append(reinterpret_cast<const char *>(&size), 4);  // little-endian, as the file is
+    attribute += value;
+    std::string out = bytes.substr(0, 8) + attribute + bytes.substr(8);
+    for (size_t at = 8; at + 8 <= bytes.size(); ++at) {
+        uint64_t offset;
+        std::memcpy(&offset, &bytes[at], 8);
+        if (offset != at + 8) continue;
+        offset += attribute.size();
+        std::memcpy(&out[at + attribute.size()], &offset, 8);
+        return out;
+    }
+    throw std::logic_error("no chunk offset table in the EXR file");
+}
+
+}  // namespace
+
+// OpenEXR allocates an attribute's value at the size its header claims before reading it (an unknown
+// type's as new char[size], up to 2 GB; a string's zero-filled): an attribute claiming more
+// than the file holds is refused from the header, naming the file, the attribute and the size, before
+// OpenEXR allocates it (the fuzzer met such headers at 78 % of its time).
+TEST(Image, ExrAttributeSizesAreCheckedBeforeOpenExrAllocatesThem) {
+    const std::string path = temp_path("attribute.exr");
+    write_exr(path, ramp(4, 3, 3));
+    const std::string good = read_bytes(path);
+    auto message = [&](const std::string &bytes) {
+        std::ofstream(path, std::ios::binary | std::ios::trunc) << bytes;
+        largest_new = 0;
+        counting_new = true;
+        std::string msg = "(read)";
+        try {
+            read_image(path);
+        } catch (const std::exception &e) {
+            msg = e.what();
+        }
+        counting_new = false;
+        return msg;
+    };
+    // A small attribute of an unknown type that the file does hold is read (OpenEXR keeps it opaque).
+    EXPECT_EQ(message(with_attribute(good, "note", "neeppnote", 5, "hello")), "(read)");
+    for (int32_t size : {2000000000, -7, 4096}) {
+        const std::string msg = message(with_attribute(good, "note", "neeppnote", size, "hello"));
+        EXPECT_NE(msg.find(path), std::string::npos) << msg;
+        EXPECT_NE(msg.find("'note'"), std::string::npos) << msg;
+        EXPECT_NE(msg.find(std::to_string(size) + " bytes"), std::string::npos) << msg;
+        EXPECT_LT(largest_new.load(), size_t(1) << 20) << size << ": " << msg;
+    }
+    // A known type's attribute (a string) claiming more than the file holds.
+    std::string msg = message(with_attribute(good, "owner", "string", 100000000, "me"));
+    EXPECT_NE(msg.find("'owner'"), std::string::npos) << msg;
+    EXPECT_NE(msg.find("100000000 bytes"), std::string::npos) << msg;
+    // OpenEXR reads a channel list up to its empty name and an int as 4 bytes, whatever their size fields
+    // say: the attribute after such a one is where OpenEXR reads it, and is checked there.
+    const std::string huge = with_attribute(good, "note", "neeppnote", 2000000000, "hello");
+    const std::string channel = std::string("Q\0", 2) + std::string(16, '\1') + '\0';
+    for (const std::string &bytes : {with_attribute(huge, "pad", "int", 1000000, "abcd"),
+                                     with_attribute(huge, "more", "chlist", 3, channel)}) {
+        msg = message(bytes);
+        EXPECT_NE(msg.find("'note'"), std::string::npos) << msg;
+        EXPECT_LT(largest_new.load(), size_t(1) << 20) << msg;
+    }
+    EXPECT_EQ(message(with_attribute(good, "pad", "int", 1000000, "abcd")), "(read)");
+    EXPECT_EQ(message(good), "(read)");
+    std::filesystem::remove(path);
+}
+
+// stb_image grows its buffer for a PNG's IDAT data to the size each chunk claims (up to 2 GB) before it
+// reads the chunk: a chunk claiming more than the file holds is refused first, naming the file, the chunk
+// and the size.
+TEST(Image, PngChunkLengthsAreCheckedBeforeTheyAreRead) {
+    const std::string path = temp_path("chunk.png");
+    write_png_srgb(path, ramp(4, 3, 3));
+    const std::string good = read_bytes(path);
+    const size_t idat = good.find("IDAT");
+    ASSERT_NE(idat, std::string::npos);
+    auto message = [&](const std::string &bytes) {
+        std::ofstream(path, std::ios::binary | std::ios::trunc) << bytes;
+        try {
+            read_image(path);
+        } catch (const std::exception &e) {
+            return std::string(e.what());
+        }
+        return std::string("(read)");
+    };
+    EXPECT_EQ(message(good), "(read)");
+    for (uint32_t length : {0x7fff0000u, 0xfffffff0u, 5000u}) {
+        std::string bad = good;
+        for (int i = 0; i < 4; ++i) bad[idat - 4 + i] = char(length >> (24 - 8 * i));  // big-endian
+        const std::string msg = message(bad);
+        EXPECT_NE(msg.find(path), std::string::npos) << msg;
+        EXPECT_NE(msg.find("chunk 'IDAT' claims " + std::to_string(length) + " bytes"), std::string::npos) << msg;
+        bool bytes_msg = false;
+        try {
+            read_image_bytes(path);
+        } catch (const std::exception &e) {
+            bytes_msg = std::string(e.what()).find("'IDAT'") != std::string::npos;
+        }
+        EXPECT_TRUE(bytes_msg) << length;
+    }
+    std::filesystem::remove(path);
+}
+
+// The header walk that checks attribute sizes steps over each known type at the size OpenEXR reads: a
+// file with an attribute of every type OpenEXR 3.1 knows (and several of the sized ones) reads, as
+// scan lines and as mipmapped tiles, so a wrong size in the walk's table would show as a refused file.
+TEST(Image, ExrWithAttributesOfEveryTypeReads) {
+    const Image img = ramp(5, 3, 3);
+    Imf::Header header(img.width, img.height);
+    header.insert("b2f", Imf::Box2fAttribute(Imath::Box2f(Imath::V2f(0.f, 1.f), Imath::V2f(2.f, 3.f))));
+    header.insert("chroma", Imf::ChromaticitiesAttribute(Imf::Chromaticities()));
+    header.insert("deep", Imf::DeepImageStateAttribute(Imf::DIS_TIDY));
+    header.insert("dbl", Imf::DoubleAttribute(2.5));
+    header.insert("env", Imf::EnvmapAttribute(Imf::ENVMAP_LATLONG));
+    header.insert("flt", Imf::FloatAttribute(1.5f));
+    header.insert("fv", Imf::FloatVectorAttribute(Imf::FloatVector{1.f, 2.f, 3.f}));
+    header.insert("num", Imf::IntAttribute(7));
+    header.insert("key", Imf::KeyCodeAttribute(Imf::KeyCode(1, 2, 3, 4, 5, 4, 64)));
+    header.insert("m33d", Imf::M33dAttribute(Imath::M33d()));
+    header.insert("m33f", Imf::M33fAttribute(Imath::M33f()));
+    header.insert("m44d", Imf::M44dAttribute(Imath::M44d()));
+    header.insert("m44f", Imf::M44fAttribute(Imath::M44f()));
+    header.insert("preview", Imf::PreviewImageAttribute(Imf::PreviewImage(3, 2)));
+    header.insert("rat", Imf::RationalAttribute(Imf::Rational(24000, 1001)));
+    header.insert("owner", Imf::StringAttribute("neepp"));
+    header.insert("sv", Imf::StringVectorAttribute(Imf::StringVector{"a", "", "bcd"}));
+    header.insert("td", Imf::TileDescriptionAttribute(Imf::TileDescription(8, 8, Imf::MIPMAP_LEVELS)));
+    header.insert("tc", Imf::TimeCodeAttribute(Imf::TimeCode(1, 2, 3, 4)));
+    header.insert("v2d", Imf::V2dAttribute(Imath::V2d(1., 2.)));
+    header.insert("v2f", Imf::V2fAttribute(Imath::V2f(1.f, 2.f)));
+    header.insert("v2i", Imf::V2iAttribute(Imath::V2i(1, 2)));
+    header.insert("v3d", Imf::V3dAttribute(Imath::V3d(1., 2., 3.)));
+    header.insert("v3f", Imf::V3fAttribute(Imath::V3f(1.f, 2.f, 3.f)));
+    header.insert("v3i", Imf::V3iAttribute(Imath::V3i(1, 2, 3)));
+    const char *names[] = {"R", "G", "B"};
+    for (const char *n : names) header.channels().insert(n, Imf::Channel(Imf::FLOAT));
+    const size_t xstride = sizeof(float) * 3, ystride = xstride * img.width;
+    Imf::FrameBuffer fb;
+    for (int c = 0; c < 3; ++c)
+        fb.insert(names[c], Imf::Slice(Imf::FLOAT, (char *)(img.data.data() + c), xstride, ystride));
+    const std::string scanlines = temp_path("attributes.exr"), tiles = temp_path("attributes_tiled.exr");
+    {
+        Imf::OutputFile file(scanlines.c_str(), header);
+        file.setFrameBuffer(fb);
+        file.writePixels(img.height);
+    }
+    {
+        Imf::Header tiled = header;
+        tiled.setTileDescription(Imf::TileDescription(2, 2, Imf::MIPMAP_LEVELS));
+        Imf::TiledOutputFile file(tiles.c_str(), tiled);
+        file.setFrameBuffer(fb);
+        for (int level = 0; level < file.numLevels(); ++level)  // each level's pixels: level 0's corner
+            file.writeTiles(0, file.numXTiles(level) - 1, 0, file.numYTiles(level) - 1, level);
+    }
+    for (const std::string &path : {scanlines, tiles}) {
+        Image back;
+        try {
+            back = read_image(path);
+        } catch (const std::exception &e) {
+            FAIL() << e.what();
+        }
+        EXPECT_EQ(back.width, img.width);
+        EXPECT_EQ(back.data, img.data) << path;
+        std::filesystem::remove(path);
+    }
+}
+
+// A regression input of fuzz_image (build-sanitize/fuzz/artifacts/image/oom-e9d85ae8...): 199 bytes of
+// baseline JPEG whose frame header asks for 16725x21334 RGB pixels. libjpeg decodes what is missing as
+// gray with a warning, so reading it took 1 GB of codes and 4 GB of floats (over the fuzzer's 2 GB);
+// it is refused from its header, naming the file and the size asked.
+TEST(Image, JpegAskingForMoreBlocksThanItsBytesCanHoldIsRefused) {
+    const std::string hex =
+        "ffd8ffe000104a46464900010100000132010080ffdb00840009060614121114140f140000000000000000000f0f0f0f"
+        "0f0f14151518151414ecebe8e3d9e1e8f0231914141f2f202327292c2c00007ffdc2361435262b2c2901090a0a0d0c0e"
+        "172901090a0a0d0c0e170f0f142c1c1c1c2a2c2929292929292929292c2c2929292929292c29292c2c292929292c2929"
+        "296a2c2c2c2c29292c2cffc0001108535641550301220002110103110100009b0001a1f012ffda000c03010002110311"
+        "003f00ec4e8c32";
+    std::string bytes;
+    for (size_t i = 0; i + 1 < hex.size(); i += 2) bytes += char(std::stoi(hex.substr(i, 2), nullptr, 16));
+    ASSERT_EQ(bytes.size(), 199u);
+    const std::string path = temp_path("huge.jpg");
+    std::ofstream(path, std::ios::binary | std::ios::trunc) << bytes;
+    rusage before{}, after{};
+    getrusage(RUSAGE_SELF, &before);
+    for (int bytes_path = 0; bytes_path < 2; ++bytes_path) {
+        std::string msg = "(read)";
+        try {
+            if (bytes_path) read_image_bytes(path);
+            else read_image(path);
+        } catch (const std::exception &e) {
+            msg = e.what();
+        }
+        EXPECT_NE(msg.find(path), std::string::npos) << msg;
+        EXPECT_NE(msg.find("16725x21334"), std::string::npos) << msg;
+    }
+    getrusage(RUSAGE_SELF, &after);
+    EXPECT_LT(after.ru_maxrss - before.ru_maxrss, 256 * 1024) << "kB grown: " << after.ru_maxrss - before.ru_maxrss;
     std::filesystem::remove(path);
 }
