@@ -10,6 +10,9 @@
 namespace neepp {
 
 void TriangleMesh::precompute() {
+    // Embree shares positions (embree_geometry) and reads a vertex buffer's last vertex with a 16-byte
+    // load: one spare element of capacity past the end. Mesh readers allocate it; a copied mesh may not have it.
+    if (positions.capacity() == positions.size()) positions.reserve(positions.size() + 1);
     const float all_bits = std::bit_cast<float>(~0u);
     lane_flip_ = flip_normals ? -0.f : 0.f;
     lane_vertex_normals_ = (face_normals || normals.empty()) ? 0.f : all_bits;
@@ -93,14 +96,20 @@ BBox TriangleMesh::bounds() const {
 RTCGeometry TriangleMesh::embree_geometry(RTCDevice device) const {
     if (indices.empty()) return nullptr;  // nothing to intersect; the shape keeps its index all the same
     RTCGeometry geom = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_TRIANGLE);
-    float *v = (float *)rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3,
-                                                3 * sizeof(float), positions.size());
-    for (size_t k = 0; k < positions.size(); ++k) {
-        v[3 * k] = positions[k].x; v[3 * k + 1] = positions[k].y; v[3 * k + 2] = positions[k].z;
+    // Embree reads the mesh's own arrays rather than copies of them: the mesh outlives the Embree scene
+    // and does not change once built. The vertex buffer needs readable bytes past its last vertex
+    // (precompute() reserves them); without them (a mesh never precomputed), Embree gets a padded copy.
+    static_assert(sizeof(Vec3) == 3 * sizeof(float) && sizeof(uint32_t) == 4);
+    if (positions.capacity() > positions.size()) {
+        rtcSetSharedGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, positions.data(), 0, sizeof(Vec3),
+                                   positions.size());
+    } else {
+        float *v = (float *)rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, sizeof(Vec3),
+                                                    positions.size());
+        std::copy_n(&positions[0].x, 3 * positions.size(), v);
     }
-    uint32_t *idx = (uint32_t *)rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
-                                                        3 * sizeof(uint32_t), triangle_count());
-    std::copy(indices.begin(), indices.end(), idx);
+    rtcSetSharedGeometryBuffer(geom, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, indices.data(), 0,
+                               3 * sizeof(uint32_t), triangle_count());
     return geom;
 }
 
