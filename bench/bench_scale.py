@@ -177,7 +177,7 @@ def part_mesh(a, out: Path, lines: list, results: dict, variant: str):
                                 timeout=3600)
     row = {"triangles": n, "ply_mb": ply.stat().st_size / 2**20,
            "neepp": {"load_s": ours.stats["load_time_s"], "peak_mb": ours.stats["peak_memory_mb"], "wall_s": ours.wall_s,
-                     "mesh_bytes_per_triangle": ours.stats["mesh_memory_mb"] * 2**20 / n},
+                     "mesh_bytes_per_triangle": ours.stats.get("mesh_memory_mb", float("nan")) * 2**20 / n},
            "mitsuba": {"load_s": theirs.stats.get("load_time_s"), "peak_mb": theirs.peak_rss_mb, "wall_s": theirs.wall_s}}
     results["mesh"] = row
     lines += [f"\n## A height field of {n} triangles ({row['ply_mb']:.0f} MB binary PLY), 320x180, 1 spp\n",
