@@ -144,7 +144,7 @@ private:
             any_uv |= x.t != kNone;
             any_normal |= x.n != kNone;
         }
-        m.positions.reserve(vertices_.size());
+        m.positions.reserve(vertices_.size() + 1);  // a spare element: Embree shares the array (TriangleMesh::precompute)
         for (const Vertex &x : vertices_) {
             m.positions.push_back(v_[x.v]);
             // Corners without a uv or normal, in a mesh where others have one, get zeros.

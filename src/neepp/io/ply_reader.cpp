@@ -332,6 +332,7 @@ private:
         const std::vector<AttributeLayout> layouts = attribute_layouts(el, "vertex_", reserved);
         Attributes attrs(layouts, el, m);
 
+        m.positions.reserve(el.count + 1);  // a spare element: Embree shares the array (TriangleMesh::precompute)
         m.positions.resize(el.count);
         if (normals) m.normals.resize(el.count);
         if (uvs) m.uvs.resize(el.count);
