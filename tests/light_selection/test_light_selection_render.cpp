@@ -104,4 +104,35 @@ TEST(LightSelectionRender, BayesSamplerLearnsOverPassesInBothForms) {
     expect_same_image(power_reference(false), learned, "bayes after learning, at 128 spp");
 }
 
+// Distributed rendering: the path integrator merges what renders with the Bayesian sampler learned,
+// through an integrator that was never prepared (as neepp.distributed merges), into a state that holds
+// every render's samples.
+TEST(LightSelectionRender, BayesStatesMergeThroughTheIntegrator) {
+    auto scene = load_scene(scene_path(false));
+    const Options options = with_scene_options(*scene, Options(OptionMap{{"light_sampler", "bayes"}}));
+    auto fresh = make_integrator("path", options);
+    fresh->prepare(*scene);
+    const std::string base = fresh->save_state();
+    auto learned = [&](uint64_t seed, uint64_t &samples) {
+        auto integ = make_integrator("path", options);
+        RenderJob job;
+        job.spp = 6;
+        job.seed = seed;
+        render(*scene, *integ, job);
+        samples = integ->statistics()["light_sampler"]["samples_learned"].get<uint64_t>();
+        return integ->save_state();
+    };
+    uint64_t na = 0, nb = 0;
+    const std::string a = learned(1, na), b = learned(2, nb);
+    ASSERT_GT(na, 0u);
+    ASSERT_GT(nb, 0u);
+    auto merger = make_integrator("path", options);  // never prepared
+    const std::string merged = merger->merge_states(base, {a, b});
+    auto resumed = make_integrator("path", options);
+    resumed->prepare(*scene);
+    resumed->restore_state(*scene, merged);
+    EXPECT_EQ(resumed->statistics()["light_sampler"]["samples_learned"].get<uint64_t>(), na + nb);
+    EXPECT_EQ(merger->merge_states(base, {a}), a);
+}
+
 }  // namespace
