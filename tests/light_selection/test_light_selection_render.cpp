@@ -101,7 +101,16 @@ TEST(LightSelectionRender, BayesSamplerLearnsOverPassesInBothForms) {
         per_seed.push_back(block_means(r.image, 6, 6));
     }
     static_cast<BlockMoments &>(learned) = moments_over_seeds(per_seed);
-    expect_same_image(power_reference(false), learned, "bayes after learning, at 128 spp");
+    expect_same_image(power_reference(false), learned, "bayes after learning, at 128 spp, against power");
+    // ... and against plain NEE with the light BVH, the sampler whose cut and descent it reweights.
+    std::vector<std::vector<double>> bvh_seeds;
+    for (int k = 0; k < kSeeds; ++k) {
+        RenderedImage r = render_scene_file(scene_path(false), 4 * kSpp, 31 + uint64_t(k) * 7919,
+                                            Options(OptionMap{{"light_sampler", "bvh"}}));
+        bvh_seeds.push_back(block_means(r.image, 6, 6));
+    }
+    BlockMoments bvh = moments_over_seeds(bvh_seeds);
+    expect_same_image(bvh, learned, "bayes after learning, at 128 spp, against bvh");
 }
 
 // Distributed rendering: the path integrator merges what renders with the Bayesian sampler learned,
