@@ -133,11 +133,14 @@ std::unique_ptr<float[]> BayesLightSampler::build_table(uint32_t key) const {
     std::vector<double> w(K);
     double total = 0;
     for (size_t j = 0; j < K; ++j) total += w[j] = std::exp(logw[j] - top);
+    // The defensive share is the prior itself, whose power part is > 0 for every node: a node the record
+    // learned nothing good of keeps a probability, and every light its descent can reach with it.
     auto t = std::make_unique<float[]>(2 * K);
     double running = 0;
     for (size_t j = 0; j < K; ++j) {
-        t[j] = float(w[j] / total);
-        running += w[j] / total;
+        const double p = (1 - options_.epsilon) * w[j] / total + options_.epsilon * p0[j];
+        t[j] = float(p);
+        running += p;
         t[K + j] = j + 1 == K ? 1.f : float(running);
     }
     return t;
@@ -161,22 +164,16 @@ SampledLight BayesLightSampler::sample(const LightSampleContext &ctx, float u) c
     }
     if (cut_.empty()) return {};
     u = std::min((u - p_inf) / (1 - p_inf), kOneMinusEpsilon);
-    SampledLight s;
-    const float eps = options_.epsilon;
-    if (u < eps) {
-        s = bvh_.sample_below(0, ctx, std::min(u / eps, kOneMinusEpsilon));
-    } else {
-        u = std::min((u - eps) / (1 - eps), kOneMinusEpsilon);
-        const float *t = table(keys_.of(ctx));
-        const size_t K = cut_.size();
-        const size_t j = std::min(size_t(std::upper_bound(t + K, t + 2 * K, u) - (t + K)), K - 1);
-        if (!(t[j] > 0)) return {};
-        const float lo = j == 0 ? 0.f : t[K + j - 1];
-        s = bvh_.sample_below(cut_[j].node, ctx, std::clamp((u - lo) / t[j], 0.f, kOneMinusEpsilon));
-    }
+    const float *t = table(keys_.of(ctx));
+    const size_t K = cut_.size();
+    const size_t j = std::min(size_t(std::upper_bound(t + K, t + 2 * K, u) - (t + K)), K - 1);
+    if (!(t[j] > 0)) return {};
+    const float lo = j == 0 ? 0.f : t[K + j - 1];
+    const SampledLight s = bvh_.sample_below(cut_[j].node, ctx, std::clamp((u - lo) / t[j], 0.f, kOneMinusEpsilon));
     if (!s.light) return {};
-    // The pmf of both strategies together, recomputed as pmf() does, so the two agree to the bit.
-    return {s.light, pmf(ctx, *s.light)};
+    // The descent below the node multiplied the same branch probabilities in the same order as pmf()'s
+    // descent_probability does, so s.pmf is pmf()'s `below` to the bit and need not be walked again.
+    return {s.light, mix(p_inf, s.pmf, t[j])};
 }
 
 float BayesLightSampler::pmf(const LightSampleContext &ctx, const Light &light) const {
@@ -188,9 +185,7 @@ float BayesLightSampler::pmf(const LightSampleContext &ctx, const Light &light) 
     const CutNode &c = cut_[j];
     const float below = bvh_.descent_probability(c.node, c.depth, t.length, t.bits, ctx);
     if (!(below > 0)) return 0.f;
-    const float above = bvh_.descent_probability(0, 0, c.depth, t.bits, ctx);
-    const float learned = table(keys_.of(ctx))[j];
-    return (1 - p_inf) * below * (options_.epsilon * above + (1 - options_.epsilon) * learned);
+    return mix(p_inf, below, table(keys_.of(ctx))[j]);
 }
 
 BayesLightSampler::PendingStats *BayesLightSampler::pending(uint32_t key) const {

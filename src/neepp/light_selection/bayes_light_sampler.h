@@ -13,8 +13,10 @@
 // - the node is chosen in proportion to the posterior expected contribution E[V]·E[x] (the paper's) or
 //   the root of its second moment √(E[V]·E[x²]) (variance-aware, as in later work), and the light below it
 //   by the plain BVH descent at the shading point.
-// The choice is mixed with the plain BVH: p(l | x) = ε · p_bvh(l | x) + (1 − ε) · P_rec(node) · p_bvh(l |
-// node, x), so every light the BVH can reach keeps a nonzero probability whatever was learned. Samples
+// p(l | x) = P_rec(node) · p_bvh(l | node, x) with P_rec = (1 − ε) · posterior + ε · prior: the prior's
+// power share is > 0 for every node, so every light the BVH can reach below its node keeps a nonzero
+// probability whatever was learned. One table lookup and the descent below the node per choice: with at
+// most cut_size lights the cut is the leaves and there is no descent at all. Samples
 // are reported during a pass (LightSelectionLearner::record, thread-safe, integer sums so the result does
 // not depend on the threads' order) and change the tables only at end_pass: within a pass the pmf is
 // fixed and exact. Infinite lights are chosen apart, as in the BVH.
@@ -30,7 +32,7 @@ namespace neepp {
 
 struct BayesSelectionOptions {
     int cut_size = 64;             // cut nodes per record (fewer when the BVH has fewer lights)
-    float epsilon = 0.1f;          // share of the plain BVH descent: the defensive floor
+    float epsilon = 0.1f;          // share of the prior in a record's node choice: the defensive floor
     bool second_moment = false;    // choose ∝ √E[(V·x)²] (variance-aware) rather than E[V·x]
     bool oriented = true;          // records per (voxel, receiver orientation) rather than per voxel
     // The prior, in pseudo-samples: kappa0 on the log-contribution's mean, gamma(alpha0, beta0) on its
@@ -82,6 +84,9 @@ private:
     static constexpr double kLogScale = 256.0;  // fixed-point steps per unit of log-contribution
     using Learned = std::vector<std::vector<NodeStats>>;  // per record; empty: nothing learned
 
+    // The pmf of a light in the tree, from the plain descent's probability below its cut node and the
+    // record's probability of the node; sample() and pmf() both end here, so they agree to the bit.
+    static float mix(float p_inf, float below, float node) { return (1 - p_inf) * below * node; }
     void build_cut();
     const float *table(uint32_t key) const;         // P_rec over the cut, then its running sum
     std::unique_ptr<float[]> build_table(uint32_t key) const;
