@@ -96,6 +96,7 @@ const std::vector<OptionMap> kOptionSets = {
     {{"light_sampler", "spatial-oriented"}},
     {{"light_sampler", "visibility"}},
     {{"light_sampler", "visibility-bvh"}},
+    {{"light_sampler", "bayes"}},  // learned in the warm-up's passes: both forms read the same tables
     {{"shadow_rays", "neepp"}},
     {{"shadow_rays", "neepp-adaptive"}},
     {{"shadow_rays", "neepp-cv"}},

@@ -18,8 +18,11 @@ REPO = Path(__file__).resolve().parents[2]
 DEMO = REPO / "scenes" / "door-ajar" / "scene.xml"
 
 
-def args(neepp_bin, out, spp, *extra):
-    return [str(neepp_bin), "render", str(DEMO), "-o", str(out), "--spp", str(spp), "--seed", "5", "--quiet",
+OFFICE = REPO / "scenes" / "office" / "scene.xml"  # many lights: a learning light sampler has something to learn
+
+
+def args(neepp_bin, out, spp, *extra, scene=DEMO):
+    return [str(neepp_bin), "render", str(scene), "-o", str(out), "--spp", str(spp), "--seed", "5", "--quiet",
             "-D", "resx=160", "-D", "resy=90", *map(str, extra)]
 
 
@@ -64,6 +67,28 @@ def test_a_stopped_render_resumes_to_the_uninterrupted_image(neepp_bin, tmp_path
     for key in ("rays", "shadow_rays", "light_rays", "splats"):
         assert s[key] == ref_stats[key], key
     assert not checkpoint.exists()  # a finished render needs it no more
+
+
+@pytest.mark.parametrize("sig", [signal.SIGKILL, signal.SIGTERM])
+def test_a_learning_light_sampler_resumes_to_the_uninterrupted_image(neepp_bin, tmp_path, sig):
+    """light_sampler=bayes learns from NEE's samples between passes: its statistics travel in the checkpoint."""
+    opts, spp = ["-I", "light_sampler=bayes"], 96
+    ref, out = tmp_path / "ref.exr", tmp_path / "out.exr"
+    subprocess.run(args(neepp_bin, ref, spp, *opts, "--stats", tmp_path / "ref.json", scene=OFFICE), check=True, timeout=300)
+    learned = json.loads((tmp_path / "ref.json").read_text())["integrator_statistics"]["light_sampler"]
+    assert learned["used"] == "bayes" and learned["samples_learned"] > 0 and learned["passes"] > 2
+    checkpoint = Path(str(out) + ".checkpoint")
+    p = subprocess.Popen(args(neepp_bin, out, spp, *opts, "--checkpoint", 0.2, scene=OFFICE))
+    wait_for(checkpoint, 120)
+    time.sleep(0.5)
+    p.send_signal(sig)
+    p.wait(timeout=60)
+    r = subprocess.run(args(neepp_bin, out, spp, *opts, "--resume", "--stats", tmp_path / "s.json", scene=OFFICE),
+                       capture_output=True, text=True, timeout=300)
+    assert r.returncode == 0, r.stderr
+    s = json.loads((tmp_path / "s.json").read_text())
+    assert 1 <= s["resumed_spp"] < spp and s["spp"] == spp
+    assert np.array_equal(read_exr(out), read_exr(ref))
 
 
 @pytest.mark.parametrize("change, expect", [(["--seed", "6"], "its seed is 5"),

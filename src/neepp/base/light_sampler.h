@@ -16,6 +16,8 @@ struct LightSampleContext {
     Vec3 n;  // geometric normal (zero for a point in a medium)
 };
 
+class LightSelectionLearner;
+
 struct SampledLight {
     const Light *light = nullptr;
     float pmf = 0;
@@ -36,6 +38,10 @@ public:
     // Called between passes, single-threaded: samplers whose tables follow the visibility map rebuild
     // them here (the next pass reads them frozen, so the pmf stays exact within a pass).
     virtual void end_pass() {}
+    // Side interface of samplers that learn from NEE's own samples (light_selection_learner.h), or null:
+    // the integrator then reports nothing.
+    virtual LightSelectionLearner *learner() { return nullptr; }
+    const LightSelectionLearner *learner() const { return const_cast<LightSampler *>(this)->learner(); }
     // Table counts, build times... for the statistics file.
     virtual nlohmann::json statistics() const { return nlohmann::json::object(); }
 };

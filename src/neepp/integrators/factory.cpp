@@ -139,7 +139,7 @@ std::unique_ptr<PathIntegrator> make_path(const Options &options, bool volumetri
     }
     // Resampling reads the map whatever the light sampler: its target holds Ṽ.
     const bool needs_map = light_sampler_needs_visibility_map(o.light_sampler) || o.within_light != "own" || o.ris > 1;
-    if (o.light_sampler.rfind("spatial", 0) == 0 || needs_map || options.get_string("shadow_rays", "nee") != "nee")
+    if (o.light_sampler.rfind("spatial", 0) == 0 || o.light_sampler.rfind("bayes", 0) == 0 || needs_map || options.get_string("shadow_rays", "nee") != "nee")
         o.voxels = options.get_int("voxels", o.voxels);
     // A light sampler reading the map needs it from the first pass: no deferred seeding then.
     std::unique_ptr<ShadowRayTester> shadow = make_shadow_ray_tester(options, needs_map, o.voxels, !needs_map);

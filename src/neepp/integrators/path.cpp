@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "neepp/base/bsdf.h"
+#include "neepp/base/light_selection_learner.h"
 #include "neepp/integrators/path_batch.h"
 #include "neepp/integrators/path_guiding.h"
 #include "neepp/integrators/path_state.h"
@@ -41,6 +42,7 @@ void PathIntegrator::prepare(const Scene &scene) {
     queries_ = &shadow_->query_tester();
     LightSelectionInputs inputs{&scene, shadow_->voxel_grid(), shadow_->visibility_map(), options_.voxels};
     light_sampler_ = make_light_sampler(options_.light_sampler, scene.light_pointers(), inputs);
+    learner_ = light_sampler_->learner();
     within_light_ = WithinLightSampling(options_.within_light, scene, shadow_->voxel_grid(), shadow_->visibility_map(),
                                         options_.area_light_sampling);
     refresh_resampling();
@@ -67,8 +69,9 @@ void PathIntegrator::end_pass(const Scene &, const PassStatistics &pass) {
 }
 
 void PathIntegrator::restore_state(const Scene &, const std::string &state) {
-    const PathState parts = PathState::decode(state, options_.guiding);
+    const PathState parts = PathState::decode(state, framed_state());
     shadow_->restore_state(parts.shadow);
+    if (learner_ && !parts.light.empty()) learner_->restore_state(parts.light);
     if (guide_ && guide_learns_ && !parts.guide.empty()) {
         guide_->load(parts.guide);
         guide_spp_ = parts.guide_spp;
@@ -173,9 +176,18 @@ Color PathIntegrator::sample_direct(const Scene &scene, const SurfaceInteraction
         W = sum / (float(M) * c[s].target);
     }
     const LightCandidate &y = c[s];
-    if (!(y.ds.pdf > 0) || is_black(y.Le)) return Color(0.f);
+    // A light sampler that learns (light_selection_learner.h) hears of every plain NEE sample, those that
+    // contribute nothing included: which lights give nothing here is half of what it learns.
+    const LightSelectionLearner *learner = M == 1 && y.light.light ? learner_ : nullptr;
+    if (!(y.ds.pdf > 0) || is_black(y.Le)) {
+        if (learner) learner->record(ctx, *y.light.light, 0.f);
+        return Color(0.f);
+    }
     const auto [f, bsdf_pdf] = M > 1 ? y.bsdf : bsdf.eval_pdf(BSDFContext{}, si, si.wi, si.to_local(y.ds.d));
-    if (is_black(f)) return Color(0.f);
+    if (is_black(f)) {
+        if (learner) learner->record(ctx, *y.light.light, 0.f);
+        return Color(0.f);
+    }
     // MIS against BSDF sampling, by the light strategy's source density (see emission_weight).
     const float light_pdf = y.ds.pdf * y.light.pmf;
     const float w_mis = y.ds.delta ? 1.f : mis_power(light_pdf, guide.pdf(y.ds.d, bsdf_pdf));
@@ -185,7 +197,9 @@ Color PathIntegrator::sample_direct(const Scene &scene, const SurfaceInteraction
     q.from = si.p;
     q.to = y.ds.p;
     q.unoccluded = M > 1 ? beta * f * y.Le * (w_mis * W) : beta * f * y.Le * (w_mis / light_pdf);
-    return q.unoccluded * test_visibility(*queries_, scene, q, sampler, counters);
+    const float visibility = test_visibility(*queries_, scene, q, sampler, counters);
+    if (learner) learner->record(ctx, *y.light.light, luminance(f * y.Le) * visibility / y.ds.pdf);
+    return q.unoccluded * visibility;
 }
 
 bool PathIntegrator::survives_roulette(Color &beta, float eta, Sampler &sampler) {

@@ -55,9 +55,9 @@ public:
     void prepare(const Scene &scene) override;
     void end_pass(const Scene &scene, const PassStatistics &pass) override;
     // While the shadow-ray policy reads or updates its visibility map (which the light sampler may read too),
-    // or the guide learns.
+    // the light sampler learns from NEE's samples, or the guide learns.
     bool learns_between_passes() const override {
-        return shadow_->learns_between_passes() || (guide_ && guide_learns_);
+        return shadow_->learns_between_passes() || (guide_ && guide_learns_) || learner_;
     }
     // What the shadow-ray component has learned (NEE++'s map, phase, calibration), and with guiding the
     // SD-tree the next pass samples (path_state.cpp).
@@ -115,6 +115,8 @@ private:
         return options_.ris_depth < 0 || depth < options_.ris_depth ? options_.ris : 1;
     }
     bool resampling() const { return options_.ris > 1; }
+    // Whether the state needs PathState's frame: guiding, or a light sampler that learns.
+    bool framed_state() const;
     // The volumetric form (volpath.cpp): Li when options_.volumetric.
     struct ScatteringPoint;
     Color Li_volumetric(const Scene &scene, const Ray &ray, Sampler &sampler, RenderCounters &counters) const;
@@ -127,6 +129,7 @@ private:
     std::unique_ptr<ShadowRayTester> shadow_;
     const ShadowRayTester *queries_ = nullptr;  // shadow_->query_tester() for the coming pass
     std::unique_ptr<LightSampler> light_sampler_;
+    LightSelectionLearner *learner_ = nullptr;  // light_sampler_'s, when it learns from NEE's samples
     std::unique_ptr<PathBatch> batch_;
     WithinLightSampling within_light_;
     ResamplingVisibility resampling_visibility_;

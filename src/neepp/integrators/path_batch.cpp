@@ -1,11 +1,14 @@
 #include "neepp/integrators/path_batch.h"
 
+#include "neepp/base/light_selection_learner.h"
+
 #include <array>
 #include <cmath>
 #include <memory>
 #include <vector>
 
 #include "neepp/base/bsdf.h"
+#include "neepp/base/light_selection_learner.h"
 #include "neepp/base/light_steps.h"
 #include "neepp/lights/light_lanes.h"
 #include "neepp/math/warp.h"
@@ -47,6 +50,7 @@ struct PathBatch::Path {
     int chosen = 0;
     float u_choice = 0;    // the resampling's variate
     float ris_weight = 0;  // its weight W = Σw / (M p̂(y))
+    float learn = 0;       // for a learning light sampler: luminance(f·Le) / pdf of the plain NEE sample
     uint32_t cell = 0;     // the shading point's voxel, for the map
     // Next event estimation's shadow query, while its ray waits to be traced with the batch's others.
     ShadowQuery shadow;
@@ -214,11 +218,20 @@ bool PathBatch::begin_direct(Path &path) const {
     const SurfaceInteraction &si = path.si;
     const DirectionSample &ds = c.sample.ds;
     const Color &Le = c.sample.radiance;
-    if (!(ds.pdf > 0) || is_black(Le)) return false;
-    const BSDF &bsdf = *si.shape->bsdf;
     const bool resampled = path.m > 1;
+    // A learning light sampler hears of every plain NEE sample, as in PathIntegrator::sample_direct.
+    const LightSelectionLearner *learner = resampled || !sl.light ? nullptr : pi.learner_;
+    if (!(ds.pdf > 0) || is_black(Le)) {
+        if (learner) learner->record(path.ctx, *sl.light, 0.f);
+        return false;
+    }
+    const BSDF &bsdf = *si.shape->bsdf;
     const auto [f, bsdf_pdf] = resampled ? c.bsdf : bsdf.eval_pdf(BSDFContext{}, si, si.wi, si.to_local(ds.d));
-    if (is_black(f)) return false;
+    if (is_black(f)) {
+        if (learner) learner->record(path.ctx, *sl.light, 0.f);
+        return false;
+    }
+    if (learner) path.learn = luminance(f * Le) / ds.pdf;
     float light_pdf = ds.pdf * sl.pmf;
     float w = ds.delta ? 1.f : mis_power(light_pdf, bsdf_pdf);  // see emission_weight
     ShadowQuery &q = path.shadow = ShadowQuery{};  // nothing the policy kept from the last bounce
@@ -240,13 +253,20 @@ bool PathBatch::decide_direct(Path &path, RenderCounters &counters) const {
     path.test = pi.queries_->begin_test(path.shadow, *path.sampler, counters);
     if (path.test.trace) return true;
     path.L += path.shadow.unoccluded * path.test.if_skipped;
+    learn_direct(path, path.test.if_skipped);
     return false;
+}
+
+void PathBatch::learn_direct(const Path &path, float visibility) const {
+    const Candidate &c = path.candidates[path.chosen];
+    if (pi_.learner_ && path.m == 1 && c.light.light) pi_.learner_->record(path.ctx, *c.light.light, path.learn * visibility);
 }
 
 void PathBatch::end_direct(Path &path, bool occluded) const {
     const PathIntegrator &pi = pi_;  // a local: the stages' stores through path cannot alias it
     pi.queries_->end_test(path.test, occluded);
     path.L += path.shadow.unoccluded * path.test.weight(occluded);
+    learn_direct(path, path.test.weight(occluded));
 }
 
 bool PathBatch::finish_vertex(Path &path) const {

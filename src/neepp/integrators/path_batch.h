@@ -40,6 +40,8 @@ private:
     bool begin_direct(Path &path) const;
     bool decide_direct(Path &path, RenderCounters &counters) const;
     void end_direct(Path &path, bool occluded) const;
+    // Tells a learning light sampler the plain NEE sample's outcome (the shadow test's weight).
+    void learn_direct(const Path &path, float visibility) const;
     // BSDF sampling and Russian roulette: the next ray, or false when the path ends.
     bool finish_vertex(Path &path) const;
 

@@ -5,12 +5,15 @@
 #include <stdexcept>
 #include <vector>
 #include "neepp/guiding/sd_tree.h"
+#include "neepp/base/light_selection_learner.h"
 #include "neepp/integrators/path.h"
+#include "neepp/light_selection/factory.h"
 
 namespace neepp {
 
 namespace {
-constexpr char kMagic[8] = {'N', 'E', 'E', 'P', 'P', 'P', 'G', '1'};
+constexpr char kMagicGuide[8] = {'N', 'E', 'E', 'P', 'P', 'P', 'G', '1'};  // shadow, guide
+constexpr char kMagic[8] = {'N', 'E', 'E', 'P', 'P', 'P', 'G', '2'};       // shadow, guide, light
 
 template <typename T> void put(std::string &out, const T &v) { out.append(reinterpret_cast<const char *>(&v), sizeof v); }
 template <typename T> T get(const std::string &data, size_t &offset) {
@@ -29,32 +32,39 @@ std::string get_bytes(const std::string &data, size_t &offset) {
 }
 }  // namespace
 
-std::string PathState::encode(bool guiding) const {
-    if (!guiding) return shadow;
+std::string PathState::encode(bool framed) const {
+    if (!framed) return shadow;
     std::string out(kMagic, sizeof kMagic);
     put(out, guide_spp);
     put(out, uint64_t(shadow.size()));
     out += shadow;
     put(out, uint64_t(guide.size()));
     out += guide;
+    put(out, uint64_t(light.size()));
+    out += light;
     return out;
 }
 
-PathState PathState::decode(const std::string &bytes, bool guiding) {
+PathState PathState::decode(const std::string &bytes, bool framed) {
     PathState s;
-    if (!guiding || bytes.empty()) {
+    if (!framed || bytes.empty()) {
         s.shadow = bytes;
         return s;
     }
-    if (bytes.size() < sizeof kMagic || std::memcmp(bytes.data(), kMagic, sizeof kMagic) != 0)
-        throw std::runtime_error("path state: not a guided path integrator's state (was it saved with -I guiding=sdtree?)");
+    const bool old = bytes.size() >= sizeof kMagicGuide && std::memcmp(bytes.data(), kMagicGuide, sizeof kMagicGuide) == 0;
+    if (!old && (bytes.size() < sizeof kMagic || std::memcmp(bytes.data(), kMagic, sizeof kMagic) != 0))
+        throw std::runtime_error("path state: not a guided or learning path integrator's state (was it saved with the same "
+                                 "-I guiding and light_sampler?)");
     size_t offset = sizeof kMagic;
     s.guide_spp = get<int32_t>(bytes, offset);
     s.shadow = get_bytes(bytes, offset);
     s.guide = get_bytes(bytes, offset);
+    if (!old) s.light = get_bytes(bytes, offset);
     if (offset != bytes.size()) throw std::runtime_error("path state: trailing bytes");
     return s;
 }
+
+bool PathIntegrator::framed_state() const { return options_.guiding || light_sampler_learns(options_.light_sampler); }
 
 std::string PathIntegrator::save_state() const {
     PathState s;
@@ -63,21 +73,24 @@ std::string PathIntegrator::save_state() const {
         s.guide = guide_->save();
         s.guide_spp = guide_spp_;
     }
-    return s.encode(options_.guiding);
+    if (learner_) s.light = learner_->save_state();
+    return s.encode(framed_state());
 }
 
 // The shadow-ray states merged as the component merges them; the trees by SDTree::merge, the guided
-// renders' sample counts by the largest (it only scales the spatial split threshold).
+// renders' sample counts by the largest (it only scales the spatial split threshold); a learning light
+// sampler's states by its own merge (which needs no prepared sampler: this integrator may be a fresh one).
 std::string PathIntegrator::merge_states(const std::string &base, const std::vector<std::string> &learned) const {
-    if (!options_.guiding) return shadow_->merge_states(base, learned);
+    if (!framed_state()) return shadow_->merge_states(base, learned);
     if (learned.empty()) return base;
     const PathState b = PathState::decode(base, true);
-    std::vector<std::string> shadows;
+    std::vector<std::string> shadows, lights;
     std::vector<SDTree> trees;
     PathState merged;
     for (const std::string &l : learned) {
         PathState s = PathState::decode(l, true);
         shadows.push_back(std::move(s.shadow));
+        lights.push_back(std::move(s.light));
         if (!s.guide.empty()) trees.push_back(SDTree::decode(s.guide));
         merged.guide_spp = std::max(merged.guide_spp, s.guide_spp);
     }
@@ -85,6 +98,7 @@ std::string PathIntegrator::merge_states(const std::string &base, const std::vec
     std::vector<const SDTree *> pointers;
     for (const SDTree &t : trees) pointers.push_back(&t);
     merged.guide = pointers.empty() ? b.guide : SDTree::merge(pointers).save();
+    merged.light = merge_light_selection_states(options_.light_sampler, b.light, lights);
     return merged.encode(true);
 }
 

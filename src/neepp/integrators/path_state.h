@@ -1,6 +1,7 @@
 // What the path integrator carries between passes for checkpoints and distributed rounds: the shadow-ray
-// component's state, and with guiding=sdtree the SD-tree and the samples per pixel it has seen. Without
-// guiding the state is the shadow-ray component's alone, as it always was.
+// component's state, with guiding=sdtree the SD-tree and the samples per pixel it has seen, and with a light
+// sampler that learns (light_selection_learner.h) what it learned. Without either the state is the
+// shadow-ray component's alone, as it always was.
 #pragma once
 #include <cstdint>
 #include <string>
@@ -11,10 +12,13 @@ struct PathState {
     std::string shadow;
     std::string guide;   // SDTree::save(); empty: none yet
     int32_t guide_spp = 0;
+    std::string light;   // the learning light sampler's; empty: none
 
-    std::string encode(bool guiding) const;
-    // Throws std::runtime_error if a guided state is malformed; an empty state is an empty one.
-    static PathState decode(const std::string &bytes, bool guiding);
+    // framed: guiding or a learning light sampler, whose parts need a frame around the shadow state.
+    std::string encode(bool framed) const;
+    // Throws std::runtime_error if a framed state is malformed; an empty state is an empty one. Reads the
+    // frame of guided states saved before the light part existed too.
+    static PathState decode(const std::string &bytes, bool framed);
 };
 
 }  // namespace neepp

@@ -229,6 +229,50 @@ float BVHLightSampler::pmf_weighted(const LightSampleContext &ctx, const Light &
     return pmf;
 }
 
+BVHLightSampler::Trail BVHLightSampler::trail(const Light &light) const {
+    if (light.index >= entries_.size() || entries_[light.index].light != &light) return {};
+    const Entry &e = entries_[light.index];
+    return {e.bits, e.length, e.infinite};
+}
+
+float BVHLightSampler::descent_probability(uint32_t node, int from, int to, uint64_t bits, const LightSampleContext &ctx,
+                                           uint32_t *end) const {
+    float p = 1.f;
+    for (int d = from; d < to; ++d) {
+        const float p0 = first_child_probability(node, ctx, nullptr);
+        if (p0 < 0) return 0.f;
+        if ((bits >> d) & 1) {
+            p *= 1 - p0;
+            node = nodes_[node].child_or_light;
+        } else {
+            p *= p0;
+            node = node + 1;
+        }
+    }
+    if (end) *end = node;
+    if (nodes_[node].leaf && !(nodes_[node].bounds.importance(ctx.p, ctx.n) > 0)) return 0.f;
+    return p;
+}
+
+SampledLight BVHLightSampler::sample_below(uint32_t node, const LightSampleContext &ctx, float u) const {
+    float pmf = 1.f;
+    while (!nodes_[node].leaf) {
+        const float p0 = first_child_probability(node, ctx, nullptr);
+        if (p0 < 0) return {};
+        if (u < p0) {
+            u = std::min(u / p0, kOneMinusEpsilon);
+            pmf *= p0;
+            node = node + 1;
+        } else {
+            u = std::min((u - p0) / (1 - p0), kOneMinusEpsilon);
+            pmf *= 1 - p0;
+            node = nodes_[node].child_or_light;
+        }
+    }
+    if (!(nodes_[node].bounds.importance(ctx.p, ctx.n) > 0)) return {};
+    return {entries_[nodes_[node].child_or_light].light, pmf};
+}
+
 nlohmann::json BVHLightSampler::statistics() const {
     return {{"nodes", nodes_.size()}, {"depth", depth_}, {"infinite_lights", infinite_.size()}};
 }

@@ -36,6 +36,25 @@ public:
     float node_power(uint32_t node) const { return nodes_[node].bounds.phi; }
     int depth() const { return depth_; }
 
+    // For samplers that choose a subtree first and let the plain descent choose below it (the Bayesian
+    // sampler's light cut). A light's path from the root: bit d set = second child at depth d.
+    struct Trail {
+        uint64_t bits = 0;
+        int length = -1;  // -1: not in the tree (infinite, or without power)
+        bool infinite = false;
+    };
+    Trail trail(const Light &light) const;
+    // The probability the plain descent gives to choosing infinite lights (each: this / count), and those.
+    float infinite_probability() const;
+    const std::vector<const Light *> &infinite_lights() const { return infinite_; }
+    // The plain descent from `node` (at depth `from`) along trail bits down to depth `to`: the product of
+    // its branch probabilities at ctx (0 where neither child can light ctx, or where `to` is a leaf that
+    // cannot), the node it ends at in *end. From the root to a light's leaf this is pmf() / (1 − p_inf).
+    float descent_probability(uint32_t node, int from, int to, uint64_t bits, const LightSampleContext &ctx,
+                              uint32_t *end = nullptr) const;
+    // The plain descent from `node` down to a light, with the probability of that light given the node.
+    SampledLight sample_below(uint32_t node, const LightSampleContext &ctx, float u) const;
+
 private:
     struct Node {
         CompactLightBounds bounds;
@@ -51,7 +70,6 @@ private:
     };
     uint32_t build(std::vector<std::pair<const Light *, LightBounds>> &items, size_t begin, size_t end,
                    uint64_t bits, int depth);
-    float infinite_probability() const;
     // Probability of descending from an interior node into its first child (-1: neither child can light
     // ctx). sample and pmf both call it, so their products agree to the bit.
     float first_child_probability(uint32_t node, const LightSampleContext &ctx, const float *factor) const;

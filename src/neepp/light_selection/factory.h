@@ -1,5 +1,6 @@
 // Creates light samplers by name: uniform, power, spatial, bvh, visibility (NEE++ over the spatial
-// estimate), visibility-power (NEE++ over power) and visibility-bvh (the light BVH reweighted by NEE++).
+// estimate), visibility-power (NEE++ over power), visibility-bvh (the light BVH reweighted by NEE++), and
+// bayes / bayes-va (the light BVH's cut learned from NEE's own samples, Vévoda et al. 2018).
 #pragma once
 #include <memory>
 #include <string>
@@ -26,6 +27,11 @@ void check_light_sampler_name(const std::string &name);
 // Whether sampler `name` over light_count lights reads the visibility map, so the integrator must keep
 // one (NEE++'s shadow-ray component). Without a count: whether it may, for some scene.
 bool light_sampler_needs_visibility_map(const std::string &name, size_t light_count = 2);
+// Whether sampler `name` learns from NEE's own samples (LightSampler::learner()), so the integrator carries
+// its state through checkpoints; and that state's merge for distributed renders, which needs no sampler.
+bool light_sampler_learns(const std::string &name);
+std::string merge_light_selection_states(const std::string &name, const std::string &base,
+                                         const std::vector<std::string> &learned);
 // Throws std::invalid_argument for unknown names or missing inputs. With a single light every sampler's
 // pmf is 1, so every name gives the cheapest, power (whose statistics then say so).
 std::unique_ptr<LightSampler> make_light_sampler(const std::string &name, std::vector<const Light *> lights,
