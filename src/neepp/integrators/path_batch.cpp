@@ -336,9 +336,8 @@ void PathBatch::Li_batch(const Scene &scene, std::span<const Ray> rays, std::spa
                 counters.rays += m;
                 for (int j = 0; j < m; ++j) scene.prefetch(*hs[j]);
             }
-            // The hit records, most of them eight at a time (HitLanes): the triangles' indices, fetched
-            // for the prefetches above, are in cache by now; their vertices are asked for first.
-            for (size_t k = 0; k < live; ++k) scene.prefetch_vertices(paths[active[k]].hit);
+            // The hit records, most of them eight at a time (HitLanes): the triangles' data, fetched
+            // for the prefetches above, is in cache by now.
             HitLanes lanes;
             for (size_t k = 0; k < live; ++k)
                 if (Path &p = paths[active[k]]; p.hit.valid()) scene.fill_in_lanes(lanes, p.hit, p.ray, p.si);

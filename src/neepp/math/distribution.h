@@ -21,8 +21,6 @@ public:
     // Continuous sampling over [0,1) with a piecewise-constant density; returns the position and its pdf.
     float sample_continuous(float u, float *pdf, uint32_t *index = nullptr) const;
     float pdf_continuous(float x) const;
-    // The heap bytes of its tables.
-    size_t memory_bytes() const { return weights_.capacity() * sizeof(float) + cdf_.capacity() * sizeof(double); }
 
 private:
     std::vector<float> weights_;

@@ -57,7 +57,6 @@ nlohmann::json render_statistics(const Scene &scene, const Integrator &integrato
         {"transmittance_lookups", c.transmittance_lookups},
         {"medium_shadow_rays", c.medium_shadow_rays},
         {"triangles", scene.triangle_count()},
-        {"mesh_memory_mb", double(scene.mesh_memory_bytes()) / (1024.0 * 1024.0)},
         {"lights", scene.lights().size()},
         {"peak_memory_mb", peak_memory_mb()},
         {"huge_pages", malloc_huge_pages()},

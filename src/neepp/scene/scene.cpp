@@ -182,13 +182,6 @@ size_t Scene::triangle_count() const {
     return n;
 }
 
-size_t Scene::mesh_memory_bytes() const {
-    size_t n = 0;
-    for (const auto &s : shapes_)
-        if (const auto *mesh = dynamic_cast<const TriangleMesh *>(s.get())) n += mesh->memory_bytes();
-    return n;
-}
-
 void Scene::build() {
     if (shapes_.empty() && lights_.empty()) throw std::runtime_error("the scene is empty: no shapes and no lights");
     rtc_scene_ = rtcNewScene(device_);

@@ -59,15 +59,10 @@ public:
     // close together in similar directions (camera rays of a few neighbouring pixels), so Embree may use
     // its coherent traversal (it saves work for camera rays; for shadow rays toward lights it costs more).
     void trace16(const Ray *const *rays, RayHit *const *hits, int n, bool coherent = false) const;
-    // Prefetches what fill() will read for hit, in two steps (TriangleMesh::prefetch): its triangle's
-    // indices, then, once those have had time to arrive, its vertices. Hints: no effect on results.
+    // Prefetches what fill() will read for hit (its triangle's record). A hint: no effect on results.
     void prefetch(const RayHit &hit) const {
         if (!hit.valid()) return;
         if (const TriangleMesh *mesh = meshes_[hit.geom]) mesh->prefetch(hit.prim);
-    }
-    void prefetch_vertices(const RayHit &hit) const {
-        if (!hit.valid()) return;
-        if (const TriangleMesh *mesh = meshes_[hit.geom]) mesh->prefetch_vertices(hit.prim);
     }
     void fill(const RayHit &hit, const Ray &ray, SurfaceInteraction &si) const {
         if (const TriangleMesh *mesh = meshes_[hit.geom]) mesh->fill_interaction(hit.prim, hit.u, hit.v, ray, hit.t, si);
@@ -102,9 +97,6 @@ public:
     const std::vector<const Light *> &infinite_lights() const { return infinite_lights_; }
     const BBox &bounds() const { return bounds_; }
     size_t triangle_count() const;
-    // The heap bytes the triangle meshes hold (TriangleMesh::memory_bytes; Embree shares their vertex and
-    // index arrays); Embree's BVH is not counted.
-    size_t mesh_memory_bytes() const;
 
     Camera camera;
     RenderSettings settings;

@@ -13,11 +13,7 @@ struct HitLanes {
     // The shape's options, as masks the kernel applies: -0 flips the normals (+0 not); all bits set where
     // the mesh has vertex normals to interpolate (and face_normals is off) / texture coordinates.
     alignas(32) float flip[kLanes], vertex_normals[kLanes], has_uv[kLanes];
-    // Each lane's triangle, gathered through the mesh's index buffer: p[3], n[3], uv[3] (zeros for what
-    // the mesh lacks), 24 floats, the rows the kernel transposes; tri[i] points at lane i's (or, for an
-    // unused lane, lane 0's).
-    alignas(32) float corners[kLanes][24];
-    const float *tri[kLanes];
+    const float *tri[kLanes];  // the triangle's record (TriangleMesh::HitTriangle)
     const TriangleMesh *shape[kLanes];
     uint32_t prim[kLanes];
     SurfaceInteraction *out[kLanes];
@@ -34,18 +30,7 @@ void fill_lanes(HitLanes &h);
 inline void add_lane(HitLanes &h, const TriangleMesh &shape, uint32_t prim, float b1, float b2, float t, const Vec3 &d,
                      SurfaceInteraction &out) {
     const int i = h.n++;
-    float *c = h.corners[i];
-    const uint32_t *v = &shape.indices[3 * prim];
-    const bool normals = !shape.normals.empty(), uvs = !shape.uvs.empty();
-    for (int k = 0; k < 3; ++k) {
-        const Vec3 &p = shape.positions[v[k]];
-        const Vec3 n = normals ? shape.normals[v[k]] : Vec3();
-        const Vec2 uv = uvs ? shape.uvs[v[k]] : Vec2();
-        c[3 * k] = p.x, c[3 * k + 1] = p.y, c[3 * k + 2] = p.z;
-        c[9 + 3 * k] = n.x, c[9 + 3 * k + 1] = n.y, c[9 + 3 * k + 2] = n.z;
-        c[18 + 2 * k] = uv.x, c[18 + 2 * k + 1] = uv.y;
-    }
-    h.tri[i] = c;
+    h.tri[i] = reinterpret_cast<const float *>(&shape.hit_triangles_[prim]);
     h.b1[i] = b1, h.b2[i] = b2, h.t[i] = t;
     h.dx[i] = d.x, h.dy[i] = d.y, h.dz[i] = d.z;
     h.flip[i] = shape.lane_flip_, h.vertex_normals[i] = shape.lane_vertex_normals_, h.has_uv[i] = shape.lane_has_uv_;

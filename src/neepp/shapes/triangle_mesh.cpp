@@ -27,6 +27,16 @@ void TriangleMesh::precompute() {
     area_ = float(total);
     triangle_distribution_ = Distribution1D(std::move(areas));
     sampling_triangles_.clear();
+    hit_triangles_.resize(triangle_count());
+    for (size_t i = 0; i < hit_triangles_.size(); ++i) {
+        HitTriangle &t = hit_triangles_[i];
+        for (int k = 0; k < 3; ++k) {
+            const uint32_t v = indices[3 * i + k];
+            t.p[k] = positions[v];
+            t.n[k] = normals.empty() ? Vec3() : normals[v];
+            t.uv[k] = uvs.empty() ? Vec2() : uvs[v];
+        }
+    }
     parallelogram_ = find_parallelogram();
     if (area_light)
         for (size_t i = 0; i < triangle_count(); ++i) sampling_triangles_.push_back(sampling_triangle(i));
@@ -140,15 +150,6 @@ DirectionCone TriangleMesh::normal_bounds() const {
     return cone;
 }
 
-size_t TriangleMesh::memory_bytes() const {
-    size_t bytes = positions.capacity() * sizeof(Vec3) + normals.capacity() * sizeof(Vec3) +
-                   uvs.capacity() * sizeof(Vec2) + indices.capacity() * sizeof(uint32_t) +
-                   sampling_triangles_.capacity() * sizeof(SamplingTriangle) + triangle_distribution_.memory_bytes();
-    if (attributes)
-        for (const MeshAttribute &a : *attributes) bytes += a.values.capacity() * sizeof(float);
-    return bytes;
-}
-
 void TriangleMesh::digest(GeometryDigest &d) const {
     d.add("mesh", 4);
     const uint64_t np = positions.size(), ni = indices.size();
@@ -174,7 +175,7 @@ PositionSample TriangleMesh::sample_position(Vec2 u, bool with_uv) const {
     const SamplingTriangle t = sampling_triangle(tri);
     ps.p = t.p0 + t.e1 * b.x + t.e2 * b.y;
     ps.n = t.n;
-    ps.ns = shading_normal(&indices[3 * tri], 1.f - b.x - b.y, b.x, b.y, t.n);
+    ps.ns = shading_normal(hit_triangles_[tri], 1.f - b.x - b.y, b.x, b.y, t.n);
     // Same uv as a ray hit at this point gets (barycentrics without texture coordinates), so textured
     // emission agrees between light sampling and BSDF sampling.
     if (analytic_uv) {
@@ -196,9 +197,9 @@ PositionSample TriangleMesh::sample_position(Vec2 u, bool with_uv) const {
 // Always inlined into fill_interaction (both of its paths; GCC otherwise keeps it out of line, and the
 // call is costly on a path this hot). Inlined, its arithmetic may fuse differently with the caller's
 // (FMA), which moves a few paths onto other random decisions: the same image statistically, not to the bit.
-[[gnu::always_inline]] inline Vec3 TriangleMesh::shading_normal(const uint32_t *v, float b0, float b1, float b2, const Vec3 &ng) const {
+[[gnu::always_inline]] inline Vec3 TriangleMesh::shading_normal(const HitTriangle &tri, float b0, float b1, float b2, const Vec3 &ng) const {
     if (face_normals || normals.empty()) return ng;
-    Vec3 ns = normals[v[0]] * b0 + normals[v[1]] * b1 + normals[v[2]] * b2;
+    Vec3 ns = tri.n[0] * b0 + tri.n[1] * b1 + tri.n[2] * b2;
     float len2 = squared_norm(ns);
     if (!(len2 > 0)) return ng;
     ns = ns / std::sqrt(len2);
@@ -210,8 +211,8 @@ void TriangleMesh::fill_interaction(uint32_t prim, float b1, float b2, const Ray
     si.t = t;
     si.shape = this;
     si.prim_index = prim;
-    const uint32_t *v = &indices[3 * prim];
-    const Vec3 &p0 = positions[v[0]], &p1 = positions[v[1]], &p2 = positions[v[2]];
+    const HitTriangle &tri = hit_triangles_[prim];
+    const Vec3 &p0 = tri.p[0], &p1 = tri.p[1], &p2 = tri.p[2];
     float b0 = 1.f - b1 - b2;
     Vec3 e1 = p1 - p0, e2 = p2 - p0;
     Vec3 ng = normalize(cross(e1, e2));
@@ -227,13 +228,13 @@ void TriangleMesh::fill_interaction(uint32_t prim, float b1, float b2, const Ray
         return;
     }
     if (!tangents) {
-        si.uv = uvs.empty() ? Vec2(b1, b2) : uvs[v[0]] * b0 + uvs[v[1]] * b1 + uvs[v[2]] * b2;
+        si.uv = uvs.empty() ? Vec2(b1, b2) : tri.uv[0] * b0 + tri.uv[1] * b1 + tri.uv[2] * b2;
         si.dpdu = si.dpdv = Vec3(0.f);
-        si.sh_frame = Frame(shading_normal(v, b0, b1, b2, ng));
+        si.sh_frame = Frame(shading_normal(tri, b0, b1, b2, ng));
         return;
     }
     if (!uvs.empty()) {
-        Vec2 uv0 = uvs[v[0]], uv1 = uvs[v[1]], uv2 = uvs[v[2]];
+        Vec2 uv0 = tri.uv[0], uv1 = tri.uv[1], uv2 = tri.uv[2];
         si.uv = uv0 * b0 + uv1 * b1 + uv2 * b2;
         Vec2 du1 = uv1 - uv0, du2 = uv2 - uv0;
         float det = du1.x * du2.y - du1.y * du2.x;
@@ -250,7 +251,7 @@ void TriangleMesh::fill_interaction(uint32_t prim, float b1, float b2, const Ray
         si.dpdu = e1; si.dpdv = e2;
     }
 
-    si.sh_frame = frame_along(shading_normal(v, b0, b1, b2, ng), si.dpdu);
+    si.sh_frame = frame_along(shading_normal(tri, b0, b1, b2, ng), si.dpdu);
 }
 
 }  // namespace neepp

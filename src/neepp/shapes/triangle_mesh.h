@@ -41,8 +41,8 @@ public:
     // The union of the face normals and the vertex normals (flipped if asked): the shading normals, which
     // decide the emission side, lie between a face's vertex normals.
     DirectionCone normal_bounds() const override;
-    // The area, the triangle-area distribution and, for emitters, the per-triangle records that light
-    // samples read.
+    // The area, the triangle-area distribution and the per-triangle records that hits (and, for
+    // emitters, light samples) read.
     void precompute() override;
     void digest(GeometryDigest &d) const override;
     size_t triangle_count() const override { return indices.size() / 3; }
@@ -73,36 +73,28 @@ public:
     // tangents, which is most of every scene's hits.
     // Not an analytic shape's, whose uv the lanes would interpolate.
     bool fills_in_lanes() const { return !tangents && !analytic_uv; }
-    // Cache prefetches of what fill_interaction(prim) reads, in two steps, as far apart as the caller can
-    // place them: the triangle's indices, then (reading those) its vertices' positions, and normals and uvs
-    // where the hit uses them. Inline: they run once per ray, from the integrator's batch loop.
+    // Cache prefetch of what fill_interaction(prim) reads: its triangle's record, two cache lines.
+    // Inline: it runs once per ray, from the integrator's batch loop.
     void prefetch(uint32_t prim) const {
-        const uint32_t *v = &indices[3 * prim];
-        __builtin_prefetch(v);
-        __builtin_prefetch(v + 2);
+        const char *record = reinterpret_cast<const char *>(&hit_triangles_[prim]);
+        __builtin_prefetch(record);
+        __builtin_prefetch(record + sizeof(HitTriangle) - 1);
     }
-    void prefetch_vertices(uint32_t prim) const {
-        const uint32_t *v = &indices[3 * prim];
-        const bool vertex_normals = !face_normals && !normals.empty(), has_uv = !uvs.empty();
-        for (int k = 0; k < 3; ++k) {
-            __builtin_prefetch(&positions[v[k]]);
-            if (vertex_normals) __builtin_prefetch(&normals[v[k]]);
-            if (has_uv) __builtin_prefetch(&uvs[v[k]]);
-        }
-    }
-    // The heap bytes this mesh holds (its arrays, its tables for sampling; attributes it shares with
-    // other instances are counted by each): what a scene's geometry costs per triangle.
-    size_t memory_bytes() const;
 
 private:
     friend void add_lane(HitLanes &h, const TriangleMesh &mesh, uint32_t prim, float b1, float b2, float t,
                          const Vec3 &d, SurfaceInteraction &out);
-    // A hit reads its triangle's corners through the index buffer (the arrays Embree shares): three
-    // indices, then a vertex from each of positions, normals and uvs. A per-triangle copy of the corners
-    // would save the indirection at the cost of more memory than the arrays and Embree's BVH together.
-    // The interpolated vertex normal of triangle v (its three indices) at barycentrics (b0, b1, b2), or the
-    // face normal ng (already flipped).
-    Vec3 shading_normal(const uint32_t *v, float b0, float b1, float b2, const Vec3 &ng) const;
+    // What a hit on one triangle reads, in one record: its corners, and its vertex normals and uvs where
+    // the mesh has them. Through the index buffer, a hit reads up to ten scattered cache lines (indices,
+    // then three vertices in each of three arrays), most of them misses on a large scene; a record is two
+    // lines (32-byte aligned, 96 bytes).
+    struct alignas(32) HitTriangle {
+        Vec3 p[3], n[3];
+        Vec2 uv[3];
+    };
+    static_assert(sizeof(HitTriangle) == 96);
+    // The interpolated vertex normal at barycentrics (b0, b1, b2), or the face normal ng (already flipped).
+    Vec3 shading_normal(const HitTriangle &tri, float b0, float b1, float b2, const Vec3 &ng) const;
     // What sampling a point on one triangle reads: a corner, the two edges from it and the unit face
     // normal (flipped if asked), one 48-byte record instead of three indices, three vertices and a
     // normalization per light sample.
@@ -116,6 +108,7 @@ private:
     float area_ = 0;
     Distribution1D triangle_distribution_;
     std::vector<SamplingTriangle> sampling_triangles_;  // precomputed for emitters (sampled at every NEE)
+    std::vector<HitTriangle> hit_triangles_;            // one per triangle, built by precompute()
     std::optional<Parallelogram> parallelogram_;
 };
 
