@@ -86,8 +86,16 @@ def test_callback_exception_stops_the_render_and_propagates():
 
 def test_ctrl_c_returns_the_image_so_far(tmp_path):
     script = tmp_path / "ctrl_c.py"
+    # The child starts with Ctrl-C as a terminal gives it: a process inherits an ignored or blocked SIGINT
+    # from its parent (here a pytest worker, whose earlier tests may have left either), and Python then
+    # never raises KeyboardInterrupt. What it inherited is printed for a failure's message.
     script.write_text(textwrap.dedent(f"""
-        import json, neepp
+        import json, signal, sys
+        print("inherited SIGINT:", signal.getsignal(signal.SIGINT), "blocked:",
+              signal.pthread_sigmask(signal.SIG_BLOCK, []), file=sys.stderr, flush=True)
+        signal.signal(signal.SIGINT, signal.default_int_handler)
+        signal.pthread_sigmask(signal.SIG_UNBLOCK, {{signal.SIGINT}})
+        import neepp
         scene = neepp.load({str(DEMO)!r}, resx=48, resy=32)
         print("rendering", flush=True)
         image, stats = neepp.render(scene, time=60)
@@ -99,7 +107,12 @@ def test_ctrl_c_returns_the_image_so_far(tmp_path):
     time.sleep(1.5)
     t0 = time.monotonic()
     p.send_signal(signal.SIGINT)
-    out, err = p.communicate(timeout=30)
+    try:
+        out, err = p.communicate(timeout=30)
+    except subprocess.TimeoutExpired:
+        p.kill()
+        out, err = p.communicate()
+        pytest.fail(f"the render did not stop within 30 s of Ctrl-C: {err[-2000:]}")
     assert p.returncode == 0, err
     assert time.monotonic() - t0 < 10
     result = json.loads(out.strip().splitlines()[-1])
