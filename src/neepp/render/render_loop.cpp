@@ -246,6 +246,7 @@ private:
     // A finished tile's block into pass_block_, in tile order (see waiting_).
     void merge_tile(size_t index, std::unique_ptr<ImageBlock> own);
     void merge_tiles_left();
+    void merge_in_order(bool past_unfinished);  // under merge_mutex_
     void merge_pass(uint64_t pass_light_paths);
     // Light paths the pass's camera samples splatted (an integrator's own pass body counts its own).
     double camera_sample_light_paths() const {
@@ -564,17 +565,22 @@ void RenderLoop::merge_tile(size_t index, std::unique_ptr<ImageBlock> own) {
     const std::lock_guard<std::mutex> lock(merge_mutex_);
     finished_[index] = 1;
     waiting_[index] = std::move(own);
-    for (; next_merge_ < tiles_.size() && finished_[next_merge_]; ++next_merge_) {
-        pass_block_.merge(display_within_pass_ ? *tile_blocks_[next_merge_] : *waiting_[next_merge_]);
-        waiting_[next_merge_].reset();
-    }
+    merge_in_order(false);
 }
 
 // A pass cut short: the tiles that finished after one that did not, still in tile order.
 void RenderLoop::merge_tiles_left() {
     const std::lock_guard<std::mutex> lock(merge_mutex_);
+    merge_in_order(true);
+}
+
+// The finished tiles from next_merge_ on, in tile order, up to the first unfinished one (or past it).
+void RenderLoop::merge_in_order(bool past_unfinished) {
     for (; next_merge_ < tiles_.size(); ++next_merge_) {
-        if (!finished_[next_merge_]) continue;
+        if (!finished_[next_merge_]) {
+            if (past_unfinished) continue;
+            return;
+        }
         pass_block_.merge(display_within_pass_ ? *tile_blocks_[next_merge_] : *waiting_[next_merge_]);
         waiting_[next_merge_].reset();
     }
