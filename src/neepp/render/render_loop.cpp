@@ -21,13 +21,12 @@
 #include "neepp/render/film.h"
 #include "neepp/render/memory.h"
 #include "neepp/render/progress_bar.h"
+#include "neepp/render/render_budget.h"
 #include "neepp/sampling/sampler.h"
 #include "neepp/scene/scene.h"
 
 namespace neepp {
 namespace {
-
-using Clock = std::chrono::steady_clock;
 
 // Camera samples handed to a ray integrator at once (RayIntegrator::batch).
 constexpr int kBatch = 32;
@@ -41,28 +40,6 @@ std::vector<Tile> make_tiles(int width, int height, int size) {
     for (int y = 0; y < height; y += size)
         for (int x = 0; x < width; x += size) tiles.push_back({x, y, std::min(size, width - x), std::min(size, height - y)});
     return tiles;
-}
-
-// Samples per pass. The first is one sample per pixel: a whole image early (what Ctrl-C leaves if it comes
-// soon) and a first measure of the speed. An integrator that learns between passes (NEE++'s map) then
-// gets small passes, so that it learns early, growing geometrically (capped) so per-pass overhead stays
-// negligible. One that does not gets full passes at once: a pixel's samples in a pass are consecutive, so
-// each packet of 16 rays the path tracer traces then starts from one pixel, and coherent rays are cheaper
-// to trace. Under a time limit a pass is sized to end before the deadline by the speed of the last
-// (with a 5% margin): a pass is all or nothing, so one cut off by the deadline would be work thrown away.
-// An interactive view (RenderJob::max_pass_s) caps a pass at what the last one's speed renders in that
-// time, and at one sample per pixel.
-int pass_size(int done, int target, double seconds_per_spp, double remaining_s, bool timed, bool learns,
-              double max_pass_s) {
-    constexpr int kMaxPass = 32;
-    int size = done == 0 ? 1 : learns ? std::min(done, kMaxPass) : kMaxPass;
-    if (max_pass_s > 0 && seconds_per_spp > 0) size = int(std::clamp(std::floor(max_pass_s / seconds_per_spp), 1.0, double(size)));
-    if (target > 0) size = std::min(size, target - done);
-    if (timed && seconds_per_spp > 0) {
-        double affordable = std::floor(0.95 * remaining_s / seconds_per_spp);
-        size = int(std::min<double>(size, affordable));
-    }
-    return size;
 }
 
 // Per-sample variance of the pixel estimates, from this pass's second moment and the image so far (see
@@ -111,39 +88,6 @@ Image combine_layers(const ImageBlock &samples, const SplatFilm *splats, double 
     }
     return image;
 }
-
-// How long the render may go on: its sample count or time limit, the time a resumed render had spent
-// before, and the size of each pass.
-class RenderBudget {
-public:
-    explicit RenderBudget(const RenderJob &job)
-        : job_(job), start_(Clock::now()), time_before_(job.resume ? job.resume->render_time_s : 0.0) {}
-    bool timed() const { return job_.time_limit_s > 0; }
-    // Seconds of rendering, a resumed render's earlier ones included.
-    double elapsed() const { return time_before_ + std::chrono::duration<double>(Clock::now() - start_).count(); }
-    double remaining() const { return timed() ? job_.time_limit_s - elapsed() : 0; }
-    bool spp_reached(int spp) const { return job_.spp > 0 && spp >= job_.spp; }
-    int next_pass_size(int done, double seconds_per_spp, bool learns) const {
-        return pass_size(done, job_.spp, seconds_per_spp, remaining(), timed(), learns, job_.max_pass_s);
-    }
-    // A time limit cuts a pass short only when it overruns badly (the first pass, whose speed was unknown,
-    // or a wrong estimate): otherwise the pass, sized to fit, is finished.
-    bool overrun(int passes_done) const {
-        return timed() && (passes_done == 0 ? elapsed() > job_.time_limit_s : elapsed() > 1.25 * job_.time_limit_s);
-    }
-    // The fraction done, for the progress bar: of the sample range, or of the time.
-    double fraction(double spp_done) const {
-        if (timed() && job_.spp <= 0) return elapsed() / job_.time_limit_s;
-        const int first = job_.resume ? 0 : job_.first_sample;
-        const double f = (spp_done - first) / double(job_.spp - first);
-        return timed() ? std::max(f, elapsed() / job_.time_limit_s) : f;
-    }
-
-private:
-    const RenderJob &job_;
-    const Clock::time_point start_;
-    const double time_before_;
-};
 
 // TBB's worker threads are one pool for the whole process, and a tbb::global_control sizes that pool for
 // the whole process, the smallest of all those alive winning. A render that held one at its own thread
