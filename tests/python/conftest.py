@@ -70,3 +70,27 @@ def pytest_collection_modifyitems(config, items):
     for item in items:
         name = item.module.__name__.rsplit(".", 1)[-1]
         item.add_marker(pytest.mark.xdist_group("ray" if name in _RAY_MODULES else name))
+
+
+def _sigint_ignored() -> bool:
+    """Whether this process ignores SIGINT (the kernel's view: a C library can set SIG_IGN behind Python's back)."""
+    try:
+        for line in Path("/proc/self/status").read_text().splitlines():
+            if line.startswith("SigIgn:"):
+                return bool(int(line.split()[1], 16) & (1 << (2 - 1)))
+    except OSError:
+        pass
+    return False
+
+
+@pytest.fixture(autouse=True)
+def _leaves_ctrl_c_as_it_found_it(request):
+    # A process inherits an ignored SIGINT, and Python then never raises KeyboardInterrupt in it: a test that
+    # leaves its worker ignoring SIGINT silently breaks every later test of Ctrl-C in that worker (the
+    # Ctrl-C test of test_package.py failed so, depending on which modules a worker had run before it).
+    before = _sigint_ignored()
+    yield
+    if _sigint_ignored() and not before:
+        import signal
+        signal.signal(signal.SIGINT, signal.default_int_handler)
+        pytest.fail(f"{request.node.nodeid} left this process ignoring SIGINT (restored for the tests after it)")
