@@ -21,6 +21,7 @@
 #include <ImfTimeCodeAttribute.h>
 #include <ImfVecAttribute.h>
 #include <gtest/gtest.h>
+#include <jpeglib.h>
 #include <stb/stb_image_write.h>
 
 #include <atomic>
@@ -646,5 +647,81 @@ TEST(Image, StbHeadersAskingForHugeImagesAreRefused) {
         EXPECT_NE(msg.find(path), std::string::npos) << msg;
         EXPECT_NE(msg.find(c.expected), std::string::npos) << c.expected << ": " << msg;
     }
+    std::filesystem::remove(path);
+}
+
+namespace {
+
+// An RGB image as JPEG through libjpeg: baseline, progressive and/or arithmetic-coded (what stb_image_write
+// cannot make).
+std::string libjpeg_encode(int w, int h, const std::vector<unsigned char> &rgb, bool progressive, bool arithmetic) {
+    jpeg_compress_struct c;
+    jpeg_error_mgr err;
+    c.err = jpeg_std_error(&err);
+    jpeg_create_compress(&c);
+    unsigned char *out = nullptr;
+    unsigned long size = 0;
+    jpeg_mem_dest(&c, &out, &size);
+    c.image_width = JDIMENSION(w), c.image_height = JDIMENSION(h), c.input_components = 3, c.in_color_space = JCS_RGB;
+    jpeg_set_defaults(&c);
+    jpeg_set_quality(&c, 90, TRUE);
+    if (progressive) jpeg_simple_progression(&c);
+    c.arith_code = arithmetic;
+    jpeg_start_compress(&c, TRUE);
+    while (c.next_scanline < c.image_height) {
+        JSAMPROW row = const_cast<unsigned char *>(&rgb[size_t(c.next_scanline) * w * 3]);
+        jpeg_write_scanlines(&c, &row, 1);
+    }
+    jpeg_finish_compress(&c);
+    std::string bytes(reinterpret_cast<const char *>(out), size);
+    jpeg_destroy_compress(&c);
+    std::free(out);
+    return bytes;
+}
+
+}  // namespace
+
+// libjpeg decodes a JPEG that ends early, or whose scan breaks off at a marker, with a warning and the rest
+// of the image gray: those are errors, for baseline, progressive and arithmetic-coded files alike.
+TEST(Image, TruncatedJpegsAreRefused) {
+    const int w = 64, h = 48;
+    const std::vector<unsigned char> px = test_pixels(w, h, 3);
+    const std::string path = temp_path("cut.jpg");
+    ASSERT_TRUE(stbi_write_jpg(path.c_str(), w, h, 3, px.data(), 90));
+    const std::string stb = read_bytes(path);
+    const std::pair<const char *, std::string> files[] = {
+        {"stb_image_write baseline", stb},
+        {"baseline", libjpeg_encode(w, h, px, false, false)},
+        {"progressive", libjpeg_encode(w, h, px, true, false)},
+        {"arithmetic", libjpeg_encode(w, h, px, false, true)},
+        {"progressive arithmetic", libjpeg_encode(w, h, px, true, true)},
+    };
+    for (const auto &[name, good] : files) {
+        SCOPED_TRACE(name);
+        ASSERT_EQ(write_and_read_message(path, good), "(read)");
+        expect_every_cut_refused(path, good);
+        const std::string msg = write_and_read_message(path, good.substr(0, good.size() * 3 / 4));
+        EXPECT_NE(msg.find("Premature end of JPEG file"), std::string::npos) << msg;
+    }
+    // Cut inside the scan, then ended properly: libjpeg meets the end-of-image marker in the middle of the scan.
+    const std::string msg = write_and_read_message(path, stb.substr(0, stb.size() * 3 / 5) + "\xff\xd9");
+    EXPECT_NE(msg.find(path), std::string::npos) << msg;
+    EXPECT_NE(msg.find("premature end of data segment"), std::string::npos) << msg;
+    std::filesystem::remove(path);
+}
+
+// Arithmetic coding has no floor of bits a block (a scan may end early, zeros implied): a header asking
+// for more than 64 blocks a byte of the file is refused before libjpeg allocates the image.
+TEST(Image, ArithmeticJpegAskingForAHugeImageIsRefused) {
+    const int w = 64, h = 48;
+    std::string bytes = libjpeg_encode(w, h, test_pixels(w, h, 3), false, true);
+    const size_t sof = bytes.find("\xff\xc9");  // start of frame, sequential arithmetic-coded
+    ASSERT_NE(sof, std::string::npos);
+    bytes.replace(sof + 5, 4, std::string("\x1f\x40\x1f\x40", 4));  // 8000 rows, 8000 columns
+    const std::string path = temp_path("huge_arith.jpg");
+    const std::string msg = write_and_read_message(path, bytes);
+    EXPECT_NE(msg.find(path), std::string::npos) << msg;
+    EXPECT_NE(msg.find("asks for 8000x8000 pixels"), std::string::npos) << msg;
+    EXPECT_NE(msg.find("64 blocks a byte"), std::string::npos) << msg;
     std::filesystem::remove(path);
 }

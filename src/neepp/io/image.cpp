@@ -13,6 +13,7 @@
 #ifdef NEEPP_HAVE_LIBJPEG
 #include <csetjmp>
 #include <jpeglib.h>
+#include <jerror.h>  // the JWRN_ codes
 #endif
 
 #include <algorithm>
@@ -70,6 +71,16 @@ ImageBytes read_jpeg(const std::string &path) {
         e->mgr.format_message(c, e->message);
         std::longjmp(e->jump, 1);
     };
+    // libjpeg decodes past a loss of data with a warning (the file ending early, a marker or a bad code in the
+    // middle of a scan), the rest of the image gray or garbage: those warnings are errors here. Others (extra
+    // bytes before a marker, an unusual JFIF version) are harmless: the image is read, without libjpeg's
+    // message on stderr.
+    err.mgr.emit_message = [](j_common_ptr c, int level) {
+        const int code = c->err->msg_code;
+        if (level < 0 && (code == JWRN_JPEG_EOF || code == JWRN_HIT_MARKER || code == JWRN_HUFF_BAD_CODE ||
+                          code == JWRN_ARITH_BAD_CODE || code == JWRN_MUST_RESYNC))
+            c->err->error_exit(c);
+    };
     ImageBytes img;
     if (setjmp(err.jump)) {  // libjpeg reports errors by longjmp to here
         jpeg_destroy_decompress(&cinfo);
@@ -82,9 +93,13 @@ ImageBytes read_jpeg(const std::string &path) {
     // a huge image from a few bytes costs all its pixels (fuzz_image met a 199-byte file asking for
     // 16725x21334 RGB: 1 GB of codes, 4 GB as floats). With Huffman coding each 8x8 block of each
     // component takes at least one bit (its DC code), so a complete file holds at least one byte per 8
-    // blocks: one asking for more blocks is refused before libjpeg allocates anything for them.
-    // Arithmetic coding has no such floor and is left alone.
-    if (!cinfo.arith_code) {
+    // blocks: one asking for more blocks is refused before libjpeg allocates anything for them. This holds for
+    // progressive files too (their first DC scans code every block). Arithmetic coding has no such floor (a
+    // scan may end early, zeros implied, and a near-constant image takes a tiny fraction of a bit a block), so
+    // there a limit is set instead: 64 blocks a byte (a 10 kB RGB file up to 13 megapixels), beyond any real
+    // arithmetic-coded photograph, keeps what such a file may cost in proportion to its size.
+    {
+        const uint64_t blocks_per_byte = cinfo.arith_code ? 64 : 8;
         std::error_code ec;
         const uintmax_t file_size = std::filesystem::file_size(path, ec);
         uint64_t blocks = 0;
@@ -96,12 +111,15 @@ ImageBytes read_jpeg(const std::string &path) {
                                (8 * uint64_t(std::max(1, cinfo.max_v_samp_factor)));
             blocks += w * h;
         }
-        if (!ec && blocks > 8 * uint64_t(file_size)) {
+        if (!ec && blocks > blocks_per_byte * uint64_t(file_size)) {
+            const std::string what = fmt::format(
+                "its JPEG header asks for {}x{} pixels of {} components ({} blocks of 8x8), more than its {} bytes "
+                "can hold ({}): a damaged header or a truncated file",
+                cinfo.image_width, cinfo.image_height, cinfo.num_components, blocks, file_size,
+                cinfo.arith_code ? "at most 64 blocks a byte are read from an arithmetic-coded file"
+                                 : "at least one bit a block");
             jpeg_destroy_decompress(&cinfo);
-            fail(path, fmt::format("its JPEG header asks for {}x{} pixels of {} components ({} blocks of 8x8), "
-                                   "more than its {} bytes can hold (at least one bit a block): a damaged header or "
-                                   "a truncated file",
-                                   cinfo.image_width, cinfo.image_height, cinfo.num_components, blocks, file_size));
+            fail(path, what);
         }
     }
     jpeg_start_decompress(&cinfo);
