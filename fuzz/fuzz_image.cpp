@@ -32,8 +32,10 @@ extern "C" int LLVMFuzzerInitialize(int *, char ***) {
         stbi_write_tga(at("rle.tga").c_str(), 12, 4, 4, px.data());
         stbi_write_hdr(at("flat.hdr").c_str(), 5, 4, 3, hdr.data());
         stbi_write_hdr(at("rle.hdr").c_str(), 12, 4, 3, hdr.data());
-        std::ofstream(at("rgb.ppm"), std::ios::binary) << "P6\n12 4\n255\n" << std::string(px.begin(), px.begin() + 144);
-        std::ofstream(at("gray16.pgm"), std::ios::binary) << "P5 12 4 65535\n" << std::string(px.begin(), px.begin() + 96);
+        std::ofstream(at("rgb.ppm"), std::ios::binary) << "P6\n12 4\n255\n"
+                                                       << std::string(px.begin(), px.begin() + 144);
+        std::ofstream(at("gray16.pgm"), std::ios::binary) << "P5 12 4 65535\n"
+                                                          << std::string(px.begin(), px.begin() + 96);
     });
     return 0;
 }

@@ -528,8 +528,14 @@ TEST(Image, TruncatedStbFilesAreRefused) {
         {"rgb.png", [&](const char *p) { return stbi_write_png(p, w, h, 3, px3.data(), w * 3) != 0; }},
         {"rgb.bmp", [&](const char *p) { return stbi_write_bmp(p, w, h, 3, px3.data()) != 0; }},
         {"rgba.bmp", [&](const char *p) { return stbi_write_bmp(p, w, h, 4, px4.data()) != 0; }},
-        {"rgb.tga", [&](const char *p) { stbi_write_tga_with_rle = 0; return stbi_write_tga(p, w, h, 3, px3.data()) != 0; }},
-        {"rle.tga", [&](const char *p) { stbi_write_tga_with_rle = 1; return stbi_write_tga(p, w, h, 4, px4.data()) != 0; }},
+        {"rgb.tga", [&](const char *p) {
+             stbi_write_tga_with_rle = 0;
+             return stbi_write_tga(p, w, h, 3, px3.data()) != 0;
+         }},
+        {"rle.tga", [&](const char *p) {
+             stbi_write_tga_with_rle = 1;
+             return stbi_write_tga(p, w, h, 4, px4.data()) != 0;
+         }},
         {"rle.hdr", [&](const char *p) { return stbi_write_hdr(p, w, h, 3, hdr.data()) != 0; }},
         {"flat.hdr", [&](const char *p) { return stbi_write_hdr(p, 5, 7, 3, hdr.data()) != 0; }},  // < 8 wide: flat
         {"rgb.ppm", [&](const char *p) {

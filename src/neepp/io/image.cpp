@@ -315,7 +315,9 @@ struct Bytes {
     unsigned operator[](size_t i) const { return i < s.size() ? (unsigned char)s[i] : '\n'; }
     uint32_t le16(size_t i) const { return (*this)[i] | (*this)[i + 1] << 8; }
     uint32_t le32(size_t i) const { return le16(i) | le16(i + 2) << 16; }
-    uint32_t be32(size_t i) const { return (*this)[i] << 24 | (*this)[i + 1] << 16 | (*this)[i + 2] << 8 | (*this)[i + 3]; }
+    uint32_t be32(size_t i) const {
+        return (*this)[i] << 24 | (*this)[i + 1] << 16 | (*this)[i + 2] << 8 | (*this)[i + 3];
+    }
     bool starts(size_t i, const char *magic) const {
         for (size_t k = 0; magic[k]; ++k)
             if ((*this)[i + k] != (unsigned char)magic[k]) return false;
