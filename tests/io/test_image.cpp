@@ -21,6 +21,8 @@
 #include <ImfTimeCodeAttribute.h>
 #include <ImfVecAttribute.h>
 #include <gtest/gtest.h>
+#include <jpeglib.h>
+#include <stb/stb_image_write.h>
 
 #include <atomic>
 #include <cmath>
@@ -30,6 +32,8 @@
 #include <iterator>
 #include <sys/resource.h>
 #include <filesystem>
+#include <functional>
+#include <vector>
 #include <fstream>
 #include <stdexcept>
 #include <string>
@@ -458,5 +462,272 @@ TEST(Image, JpegAskingForMoreBlocksThanItsBytesCanHoldIsRefused) {
     }
     getrusage(RUSAGE_SELF, &after);
     EXPECT_LT(after.ru_maxrss - before.ru_maxrss, 256 * 1024) << "kB grown: " << after.ru_maxrss - before.ru_maxrss;
+    std::filesystem::remove(path);
+}
+
+namespace {
+
+// What reading the file gives: "(read)", or the error's message. Both entry points are run: read_image, and
+// read_image_bytes, which may answer std::nullopt (a float format) but never an image the other refuses.
+std::string read_message(const std::string &path) {
+    std::string msg = "(read)";
+    try {
+        read_image(path);
+    } catch (const std::exception &e) {
+        msg = e.what();
+    }
+    try {
+        read_image_bytes(path);
+        if (msg != "(read)") return msg + " [but read_image_bytes read it]";
+    } catch (const std::exception &e) {
+        if (msg == "(read)") return std::string("(read) [but read_image_bytes: ") + e.what() + "]";
+    }
+    return msg;
+}
+
+std::string write_and_read_message(const std::string &path, const std::string &bytes) {
+    std::ofstream(path, std::ios::binary | std::ios::trunc) << bytes;
+    return read_message(path);
+}
+
+// 8-bit pixels with both runs (a flat band) and noise, so that run-length coding leaves data to cut.
+std::vector<unsigned char> test_pixels(int w, int h, int c) {
+    std::vector<unsigned char> px(size_t(w) * h * c);
+    for (size_t i = 0; i < px.size(); ++i) px[i] = (i / c) % w < size_t(w) / 3 ? 200 : (unsigned char)(i * 37 % 251);
+    return px;
+}
+
+// The file cut at several points, from nothing to all but its last byte: every one is refused, naming the
+// file.
+void expect_every_cut_refused(const std::string &path, const std::string &good) {
+    const size_t n = good.size();
+    for (size_t cut : {size_t(0), size_t(1), size_t(2), size_t(5), size_t(11), size_t(17), size_t(30), size_t(60),
+                       n / 4, n / 2, 3 * n / 4, n - n / 8, n - 13, n - 1}) {
+        if (cut >= n) continue;
+        const std::string msg = write_and_read_message(path, good.substr(0, cut));
+        EXPECT_NE(msg.find(path), std::string::npos) << "cut at " << cut << " of " << n << ": " << msg;
+        EXPECT_EQ(msg.find("(read)"), std::string::npos) << "cut at " << cut << " of " << n << ": " << msg;
+    }
+}
+
+}  // namespace
+
+// stb_image reads past the end of a file as zeros: each format it decodes for neepp is checked so that a
+// truncated file is refused, by its header's size where the pixels are stored plainly (BMP, TGA, PNM, flat
+// HDR) and by seeing stb_image read past the end where they are run-length coded (TGA, HDR) or deflated (PNG).
+TEST(Image, TruncatedStbFilesAreRefused) {
+    const int w = 36, h = 5;
+    const std::vector<unsigned char> px3 = test_pixels(w, h, 3), px4 = test_pixels(w, h, 4);
+    std::vector<float> hdr(size_t(w) * h * 3);
+    for (size_t i = 0; i < hdr.size(); ++i) hdr[i] = px3[i] / 32.f + 0.01f;
+    struct Case {
+        std::string name;
+        std::function<bool(const char *)> write;
+    };
+    const Case cases[] = {
+        {"rgb.png", [&](const char *p) { return stbi_write_png(p, w, h, 3, px3.data(), w * 3) != 0; }},
+        {"rgb.bmp", [&](const char *p) { return stbi_write_bmp(p, w, h, 3, px3.data()) != 0; }},
+        {"rgba.bmp", [&](const char *p) { return stbi_write_bmp(p, w, h, 4, px4.data()) != 0; }},
+        {"rgb.tga", [&](const char *p) {
+             stbi_write_tga_with_rle = 0;
+             return stbi_write_tga(p, w, h, 3, px3.data()) != 0;
+         }},
+        {"rle.tga", [&](const char *p) {
+             stbi_write_tga_with_rle = 1;
+             return stbi_write_tga(p, w, h, 4, px4.data()) != 0;
+         }},
+        {"rle.hdr", [&](const char *p) { return stbi_write_hdr(p, w, h, 3, hdr.data()) != 0; }},
+        {"flat.hdr", [&](const char *p) { return stbi_write_hdr(p, 5, 7, 3, hdr.data()) != 0; }},  // < 8 wide: flat
+        {"rgb.ppm", [&](const char *p) {
+             std::ofstream(p, std::ios::binary) << "P6\n# neepp\n" << w << " " << h << "\n255\n"
+                                                << std::string(px3.begin(), px3.end());
+             return true;
+         }},
+        {"gray16.pgm", [&](const char *p) {
+             std::ofstream(p, std::ios::binary) << "P5 " << w << " " << h << " 65535\n"
+                                                << std::string(px3.begin(), px3.begin() + 2 * w * h);
+             return true;
+         }},
+    };
+    for (const Case &c : cases) {
+        const std::string path = temp_path("cut_" + c.name);
+        ASSERT_TRUE(c.write(path.c_str())) << c.name;
+        const std::string good = read_bytes(path);
+        ASSERT_EQ(read_message(path), "(read)") << c.name;
+        const Image img = read_image(path);
+        EXPECT_EQ(img.height, c.name == "flat.hdr" ? 7 : h) << c.name;
+        if (c.name.find(".hdr") == std::string::npos && c.name != "gray16.pgm") {  // 8-bit: the codes back
+            const std::vector<unsigned char> &expected = img.channels == 4 ? px4 : px3;
+            for (int x = 0; x < img.width; ++x)
+                EXPECT_FLOAT_EQ(img.at(x, h - 1, 1) * 255.f, expected[(size_t(h - 1) * w + x) * img.channels + 1])
+                    << c.name << " x " << x;
+        }
+        expect_every_cut_refused(path, good);
+        std::filesystem::remove(path);
+    }
+}
+
+// Where the pixels are stored plainly the header says how many bytes they take: a file with fewer is refused
+// from its header, saying so; where they are run-length coded, by stb_image reading past the end (which,
+// for an HDR scan line cut short, stb_image 2.27 would otherwise do forever).
+TEST(Image, TruncatedStbFilesSayWhy) {
+    const int w = 36, h = 5;
+    const std::vector<unsigned char> px = test_pixels(w, h, 3);
+    std::vector<float> hdr(size_t(w) * h * 3);
+    for (size_t i = 0; i < hdr.size(); ++i) hdr[i] = px[i] / 32.f + 0.01f;
+    const std::string path = temp_path("why.img");
+    auto cut_message = [&](double fraction) {
+        const std::string good = read_bytes(path);
+        return write_and_read_message(path, good.substr(0, size_t(good.size() * fraction)));
+    };
+    stbi_write_bmp(path.c_str(), w, h, 3, px.data());
+    std::string msg = cut_message(0.5);
+    EXPECT_NE(msg.find("its BMP header asks for 36x5 pixels, which need 594 bytes"), std::string::npos) << msg;
+    stbi_write_tga_with_rle = 0;
+    stbi_write_tga(path.c_str(), w, h, 3, px.data());
+    msg = cut_message(0.9);
+    EXPECT_NE(msg.find("its TGA header asks for 36x5 pixels, which need 558 bytes"), std::string::npos) << msg;
+    stbi_write_tga_with_rle = 1;
+    stbi_write_tga(path.c_str(), w, h, 3, px.data());
+    msg = cut_message(0.7);
+    EXPECT_NE(msg.find("the file ends before its TGA image data does"), std::string::npos) << msg;
+    stbi_write_hdr(path.c_str(), w, h, 3, hdr.data());
+    msg = cut_message(0.7);
+    EXPECT_NE(msg.find("the file ends before its Radiance HDR image data does"), std::string::npos) << msg;
+    std::filesystem::remove(path);
+}
+
+// A header asking for a huge image from a small file is refused from the header, naming the size, before
+// stb_image allocates it (up to 2 GB each).
+TEST(Image, StbHeadersAskingForHugeImagesAreRefused) {
+    const int w = 36, h = 5;
+    const std::vector<unsigned char> px = test_pixels(w, h, 3);
+    const std::string path = temp_path("huge.img");
+    auto patched = [&](auto write, size_t at, const std::string &bytes) {
+        write();
+        std::string good = read_bytes(path);
+        good.replace(at, bytes.size(), bytes);
+        return good;
+    };
+    auto le = [](uint32_t v, int n) {
+        std::string s;
+        for (int i = 0; i < n; ++i) s += char(v >> (8 * i));
+        return s;
+    };
+    struct Case {
+        std::string bytes, expected;
+    };
+    const auto bmp = [&] { stbi_write_bmp(path.c_str(), w, h, 3, px.data()); };
+    const auto tga = [&] { stbi_write_tga(path.c_str(), w, h, 3, px.data()); };
+    stbi_write_tga_with_rle = 0;
+    std::vector<Case> cases = {
+        {patched(bmp, 18, le(30000, 4) + le(30000, 4)), "BMP header asks for 30000x30000 pixels"},
+        {patched(bmp, 22, le(uint32_t(-20000), 4)), "BMP header asks for 36x20000 pixels"},  // top-down rows
+        {patched(bmp, 22, le(0x80000000u, 4)), "BMP header asks for 36x2147483648 pixels"},
+        {patched(bmp, 28, le(2, 2)), "2 bits a pixel"},
+        {patched(tga, 12, le(65535, 2) + le(65535, 2)), "TGA header asks for 65535x65535 pixels"},
+        {"#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y 30000 +X 30000\n" + std::string(64, '\x02'),
+         "Radiance HDR header asks for 30000x30000 pixels, which need at least"},
+        {"#?RGBE\nFORMAT=32-bit_rle_rgbe\n\n-Y 100 +X 5\n" + std::string(64, '\x01'),
+         "Radiance HDR header asks for 5x100 pixels, which need 2043 bytes of the file, but it has 107"},
+        {"#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y 0 +X 30\n" + std::string(64, '\x01'), "30x0 pixels: no image"},
+        {"P6\n30000 30000\n255\n" + std::string(64, 'x'), "PNM header asks for 30000x30000 pixels"},
+        {"P5\n99999999999999999999999 2\n255\n" + std::string(64, 'x'), "PNM header asks for"},
+        {"P5\n#" + std::string(200, 'c') + "\n2 2\n255\nxxxx", "PNM header is 213 bytes long"},
+        {"GIF89a" + le(30000, 2) + le(30000, 2) + std::string(64, '\0'), "GIF images are not read"},
+        {"8BPS" + std::string(64, '\0'), "Photoshop (PSD) images are not read"},
+        {"\xff\xff\xd8" + std::string(64, '\0'), "Not a JPEG file"},
+        {"not an image at all", "not an image format neepp reads"},
+    };
+    // A PNG whose IHDR asks for 30000x30000 RGB (2.7 GB) from some 200 bytes of deflated data.
+    stbi_write_png(path.c_str(), w, h, 3, px.data(), w * 3);
+    std::string png = read_bytes(path);
+    png.replace(16, 8, std::string("\0\0\x75\x30\0\0\x75\x30", 8));
+    cases.push_back({png, "PNG header asks for 30000x30000 pixels (2700000000 bytes), more than its"});
+    for (const Case &c : cases) {
+        const std::string msg = write_and_read_message(path, c.bytes);
+        if (c.expected.empty()) {
+            EXPECT_NE(msg.find(path), std::string::npos) << msg;
+            continue;
+        }
+        EXPECT_NE(msg.find(path), std::string::npos) << msg;
+        EXPECT_NE(msg.find(c.expected), std::string::npos) << c.expected << ": " << msg;
+    }
+    std::filesystem::remove(path);
+}
+
+namespace {
+
+// An RGB image as JPEG through libjpeg: baseline, progressive and/or arithmetic-coded (what stb_image_write
+// cannot make).
+std::string libjpeg_encode(int w, int h, const std::vector<unsigned char> &rgb, bool progressive, bool arithmetic) {
+    jpeg_compress_struct c;
+    jpeg_error_mgr err;
+    c.err = jpeg_std_error(&err);
+    jpeg_create_compress(&c);
+    unsigned char *out = nullptr;
+    unsigned long size = 0;
+    jpeg_mem_dest(&c, &out, &size);
+    c.image_width = JDIMENSION(w), c.image_height = JDIMENSION(h), c.input_components = 3, c.in_color_space = JCS_RGB;
+    jpeg_set_defaults(&c);
+    jpeg_set_quality(&c, 90, TRUE);
+    if (progressive) jpeg_simple_progression(&c);
+    c.arith_code = arithmetic;
+    jpeg_start_compress(&c, TRUE);
+    while (c.next_scanline < c.image_height) {
+        JSAMPROW row = const_cast<unsigned char *>(&rgb[size_t(c.next_scanline) * w * 3]);
+        jpeg_write_scanlines(&c, &row, 1);
+    }
+    jpeg_finish_compress(&c);
+    std::string bytes(reinterpret_cast<const char *>(out), size);
+    jpeg_destroy_compress(&c);
+    std::free(out);
+    return bytes;
+}
+
+}  // namespace
+
+// libjpeg decodes a JPEG that ends early, or whose scan breaks off at a marker, with a warning and the rest
+// of the image gray: those are errors, for baseline, progressive and arithmetic-coded files alike.
+TEST(Image, TruncatedJpegsAreRefused) {
+    const int w = 64, h = 48;
+    const std::vector<unsigned char> px = test_pixels(w, h, 3);
+    const std::string path = temp_path("cut.jpg");
+    ASSERT_TRUE(stbi_write_jpg(path.c_str(), w, h, 3, px.data(), 90));
+    const std::string stb = read_bytes(path);
+    const std::pair<const char *, std::string> files[] = {
+        {"stb_image_write baseline", stb},
+        {"baseline", libjpeg_encode(w, h, px, false, false)},
+        {"progressive", libjpeg_encode(w, h, px, true, false)},
+        {"arithmetic", libjpeg_encode(w, h, px, false, true)},
+        {"progressive arithmetic", libjpeg_encode(w, h, px, true, true)},
+    };
+    for (const auto &[name, good] : files) {
+        SCOPED_TRACE(name);
+        ASSERT_EQ(write_and_read_message(path, good), "(read)");
+        expect_every_cut_refused(path, good);
+        const std::string msg = write_and_read_message(path, good.substr(0, good.size() * 3 / 4));
+        EXPECT_NE(msg.find("Premature end of JPEG file"), std::string::npos) << msg;
+    }
+    // Cut inside the scan, then ended properly: libjpeg meets the end-of-image marker in the middle of the scan.
+    const std::string msg = write_and_read_message(path, stb.substr(0, stb.size() * 3 / 5) + "\xff\xd9");
+    EXPECT_NE(msg.find(path), std::string::npos) << msg;
+    EXPECT_NE(msg.find("premature end of data segment"), std::string::npos) << msg;
+    std::filesystem::remove(path);
+}
+
+// Arithmetic coding has no floor of bits a block (a scan may end early, zeros implied): a header asking
+// for more than 64 blocks a byte of the file is refused before libjpeg allocates the image.
+TEST(Image, ArithmeticJpegAskingForAHugeImageIsRefused) {
+    const int w = 64, h = 48;
+    std::string bytes = libjpeg_encode(w, h, test_pixels(w, h, 3), false, true);
+    const size_t sof = bytes.find("\xff\xc9");  // start of frame, sequential arithmetic-coded
+    ASSERT_NE(sof, std::string::npos);
+    bytes.replace(sof + 5, 4, std::string("\x1f\x40\x1f\x40", 4));  // 8000 rows, 8000 columns
+    const std::string path = temp_path("huge_arith.jpg");
+    const std::string msg = write_and_read_message(path, bytes);
+    EXPECT_NE(msg.find(path), std::string::npos) << msg;
+    EXPECT_NE(msg.find("asks for 8000x8000 pixels"), std::string::npos) << msg;
+    EXPECT_NE(msg.find("64 blocks a byte"), std::string::npos) << msg;
     std::filesystem::remove(path);
 }

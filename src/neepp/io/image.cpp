@@ -13,6 +13,7 @@
 #ifdef NEEPP_HAVE_LIBJPEG
 #include <csetjmp>
 #include <jpeglib.h>
+#include <jerror.h>  // the JWRN_ codes
 #endif
 
 #include <algorithm>
@@ -43,7 +44,9 @@ FileKind sniff(const std::string &path) {
     size_t n = std::fread(magic, 1, 4, f.get());
     static const unsigned char kExrMagic[4] = {0x76, 0x2f, 0x31, 0x01};
     if (n == 4 && std::memcmp(magic, kExrMagic, 4) == 0) return FileKind::Exr;
-    if (n >= 2 && magic[0] == 0xff && magic[1] == 0xd8) return FileKind::Jpeg;
+    // Start-of-image, or 0xff fill bytes before it, which stb_image (not libjpeg) would read as JPEG: libjpeg
+    // refuses those, naming them, rather than stb_image decoding them unchecked.
+    if (n >= 2 && magic[0] == 0xff && (magic[1] == 0xd8 || magic[1] == 0xff)) return FileKind::Jpeg;
     return FileKind::Other;
 }
 
@@ -68,6 +71,16 @@ ImageBytes read_jpeg(const std::string &path) {
         e->mgr.format_message(c, e->message);
         std::longjmp(e->jump, 1);
     };
+    // libjpeg decodes past a loss of data with a warning (the file ending early, a marker or a bad code in the
+    // middle of a scan), the rest of the image gray or garbage: those warnings are errors here. Others (extra
+    // bytes before a marker, an unusual JFIF version) are harmless: the image is read, without libjpeg's
+    // message on stderr.
+    err.mgr.emit_message = [](j_common_ptr c, int level) {
+        const int code = c->err->msg_code;
+        if (level < 0 && (code == JWRN_JPEG_EOF || code == JWRN_HIT_MARKER || code == JWRN_HUFF_BAD_CODE ||
+                          code == JWRN_ARITH_BAD_CODE || code == JWRN_MUST_RESYNC))
+            c->err->error_exit(c);
+    };
     ImageBytes img;
     if (setjmp(err.jump)) {  // libjpeg reports errors by longjmp to here
         jpeg_destroy_decompress(&cinfo);
@@ -80,9 +93,13 @@ ImageBytes read_jpeg(const std::string &path) {
     // a huge image from a few bytes costs all its pixels (fuzz_image met a 199-byte file asking for
     // 16725x21334 RGB: 1 GB of codes, 4 GB as floats). With Huffman coding each 8x8 block of each
     // component takes at least one bit (its DC code), so a complete file holds at least one byte per 8
-    // blocks: one asking for more blocks is refused before libjpeg allocates anything for them.
-    // Arithmetic coding has no such floor and is left alone.
-    if (!cinfo.arith_code) {
+    // blocks: one asking for more blocks is refused before libjpeg allocates anything for them. This holds for
+    // progressive files too (their first DC scans code every block). Arithmetic coding has no such floor (a
+    // scan may end early, zeros implied, and a near-constant image takes a tiny fraction of a bit a block), so
+    // there a limit is set instead: 64 blocks a byte (a 10 kB RGB file up to 13 megapixels), beyond any real
+    // arithmetic-coded photograph, keeps what such a file may cost in proportion to its size.
+    {
+        const uint64_t blocks_per_byte = cinfo.arith_code ? 64 : 8;
         std::error_code ec;
         const uintmax_t file_size = std::filesystem::file_size(path, ec);
         uint64_t blocks = 0;
@@ -94,12 +111,15 @@ ImageBytes read_jpeg(const std::string &path) {
                                (8 * uint64_t(std::max(1, cinfo.max_v_samp_factor)));
             blocks += w * h;
         }
-        if (!ec && blocks > 8 * uint64_t(file_size)) {
+        if (!ec && blocks > blocks_per_byte * uint64_t(file_size)) {
+            const std::string what = fmt::format(
+                "its JPEG header asks for {}x{} pixels of {} components ({} blocks of 8x8), more than its {} bytes "
+                "can hold ({}): a damaged header or a truncated file",
+                cinfo.image_width, cinfo.image_height, cinfo.num_components, blocks, file_size,
+                cinfo.arith_code ? "at most 64 blocks a byte are read from an arithmetic-coded file"
+                                 : "at least one bit a block");
             jpeg_destroy_decompress(&cinfo);
-            fail(path, fmt::format("its JPEG header asks for {}x{} pixels of {} components ({} blocks of 8x8), "
-                                   "more than its {} bytes can hold (at least one bit a block): a damaged header or "
-                                   "a truncated file",
-                                   cinfo.image_width, cinfo.image_height, cinfo.num_components, blocks, file_size));
+            fail(path, what);
         }
     }
     jpeg_start_decompress(&cinfo);
@@ -269,40 +289,374 @@ Image image_from_stb(T *pixels, int w, int h, int n, float scale, bool srgb) {
     fail(path, fmt::format("unsupported or corrupt image file ({})", why ? why : "unknown error"));
 }
 
+// The formats stb_image reads, told apart by the tests stb_image itself makes, in its order
+// (stbi__load_main), so that the format checked below is the one stb_image then decodes.
+enum class StbFormat { Png, Bmp, Gif, Psd, Pic, Jpeg, Pnm, Hdr, Tga, Unknown };
+
+const char *format_name(StbFormat f) {
+    switch (f) {
+        case StbFormat::Png: return "PNG";
+        case StbFormat::Bmp: return "BMP";
+        case StbFormat::Gif: return "GIF";
+        case StbFormat::Psd: return "Photoshop (PSD)";
+        case StbFormat::Pic: return "Softimage PIC";
+        case StbFormat::Jpeg: return "JPEG";
+        case StbFormat::Pnm: return "PNM";
+        case StbFormat::Hdr: return "Radiance HDR";
+        case StbFormat::Tga: return "TGA";
+        default: return "unknown";
+    }
+}
+
+// A file's bytes, read the way stb_image reads them through stbi_io_callbacks: past the end, as '\n'
+// (see StbInput).
+struct Bytes {
+    const std::string &s;
+    unsigned operator[](size_t i) const { return i < s.size() ? (unsigned char)s[i] : '\n'; }
+    uint32_t le16(size_t i) const { return (*this)[i] | (*this)[i + 1] << 8; }
+    uint32_t le32(size_t i) const { return le16(i) | le16(i + 2) << 16; }
+    uint32_t be32(size_t i) const {
+        return (*this)[i] << 24 | (*this)[i + 1] << 16 | (*this)[i + 2] << 8 | (*this)[i + 3];
+    }
+    bool starts(size_t i, const char *magic) const {
+        for (size_t k = 0; magic[k]; ++k)
+            if ((*this)[i + k] != (unsigned char)magic[k]) return false;
+        return true;
+    }
+};
+
+bool stb_tga_test(const Bytes &b) {  // stbi__tga_test: TGA has no magic number, only plausible fields
+    const unsigned color_type = b[1], image_type = b[2];
+    if (color_type > 1) return false;
+    if (color_type == 1) {
+        if (image_type != 1 && image_type != 9) return false;
+        const unsigned palette_bits = b[7];
+        if (palette_bits != 8 && palette_bits != 15 && palette_bits != 16 && palette_bits != 24 && palette_bits != 32)
+            return false;
+    } else if (image_type != 2 && image_type != 3 && image_type != 10 && image_type != 11) {
+        return false;
+    }
+    if (b.le16(12) < 1 || b.le16(14) < 1) return false;
+    const unsigned bpp = b[16];
+    if (color_type == 1 && bpp != 8 && bpp != 16) return false;
+    return bpp == 8 || bpp == 15 || bpp == 16 || bpp == 24 || bpp == 32;
+}
+
+StbFormat stb_format(const Bytes &b) {
+    if (b.starts(0, "\x89PNG\r\n\x1a\n")) return StbFormat::Png;
+    if (b.starts(0, "BM")) {
+        const uint32_t header = b.le32(14);
+        if (header == 12 || header == 40 || header == 56 || header == 108 || header == 124) return StbFormat::Bmp;
+    }
+    if (b.starts(0, "GIF8") && (b[4] == '7' || b[4] == '9') && b[5] == 'a') return StbFormat::Gif;
+    if (b.starts(0, "8BPS")) return StbFormat::Psd;
+    if (b.starts(0, "\x53\x80\xf6\x34") && b.starts(88, "PICT")) return StbFormat::Pic;
+    if (b[0] == 0xff) {  // a marker: 0xff, any fill bytes 0xff, then start-of-image
+        size_t i = 1;
+        while (i < b.s.size() && b[i] == 0xff) ++i;
+        if (b[i] == 0xd8) return StbFormat::Jpeg;
+    }
+    if (b[0] == 'P' && (b[1] == '5' || b[1] == '6')) return StbFormat::Pnm;
+    if (b.starts(0, "#?RADIANCE\n") || b.starts(0, "#?RGBE\n")) return StbFormat::Hdr;
+    if (stb_tga_test(b)) return StbFormat::Tga;
+    return StbFormat::Unknown;
+}
+
+// stb_image reads a file that ends early as if zeros followed (a truncated BMP, TGA, HDR or PNM loads with
+// black or garbage pixels), and it allocates the image its header asks for (up to 2 GB) before reading a
+// pixel. So each format's header is read here first, and a file shorter than the bytes its pixels need
+// (exactly, for uncompressed data; at the least, for run-length or deflate coded data) is refused before
+// stb_image allocates anything. What the header cannot tell (a run-length coded file cut short) is seen as
+// stb_image reading past the end (StbInput). Each check mirrors what stb_image 2.27 (Debian's libstb)
+// reads; where stb_image refuses a header itself before allocating, the check leaves it to it.
+struct StbHeader {
+    int64_t width = 0, height = 0;
+    uint64_t need = 0;      // bytes of the file its pixels need (at least, where `exact` is false)
+    bool exact = true;
+    bool sixteen_bit = false;
+    bool checked = false;   // false: stb_image refuses this header before allocating
+};
+
+StbHeader bmp_header(const Bytes &b) {  // stbi__bmp_parse_header and stbi__bmp_load
+    StbHeader h;
+    const uint32_t offset = b.le32(10), header = b.le32(14);
+    uint32_t bpp, compression = 0;
+    if (header == 12) {
+        h.width = b.le16(18), h.height = b.le16(20), bpp = b.le16(24);
+    } else {
+        h.width = b.le32(18), h.height = std::abs(int64_t(int32_t(b.le32(22)))), bpp = b.le16(28);
+        compression = b.le32(30);
+    }
+    // stb_image refuses run-length (1, 2) and JPEG/PNG (4, 5) BMPs and a negative offset from the header.
+    if ((compression != 0 && compression != 3) || int32_t(offset) < 0) return h;
+    uint64_t row;  // a row's bytes, then padding to a multiple of 4
+    switch (bpp) {
+        case 1: row = (uint64_t(h.width) + 7) / 8; break;
+        case 4: row = (uint64_t(h.width) + 1) / 2; break;
+        case 8: case 16: case 24: case 32: row = uint64_t(h.width) * (bpp / 8); break;
+        default: throw std::runtime_error(fmt::format("its BMP header gives {} bits a pixel (only 1, 4, 8, 16, 24 "
+                                                      "and 32 are read)", bpp));
+    }
+    const uint64_t stride = (row + 3) / 4 * 4;
+    // The pixels start at the header's offset; the last row's padding may be left out.
+    h.need = h.height > 0 ? uint64_t(offset) + (uint64_t(h.height) - 1) * stride + row : offset;
+    h.checked = true;
+    return h;
+}
+
+StbHeader tga_header(const Bytes &b) {  // stbi__tga_load
+    StbHeader h;
+    const unsigned id_length = b[0], indexed = b[1], image_type = b[2], palette_bits = b[7], bpp = b[16];
+    h.width = b.le16(12), h.height = b.le16(14);
+    uint64_t start = 18 + id_length;
+    if (indexed) start += b.le16(3) + uint64_t(b.le16(5)) * ((palette_bits + 7) / 8);  // skipped, then the palette
+    const uint64_t pixel = (bpp + 7) / 8, pixels = uint64_t(h.width) * uint64_t(h.height);
+    if (image_type >= 8) {  // run-length coded: packets of a count byte and one pixel, up to 128 pixels each
+        h.need = start + (pixels + 127) / 128 * (1 + pixel);
+        h.exact = false;
+    } else {
+        h.need = start + pixels * pixel;
+    }
+    h.checked = true;
+    return h;
+}
+
+StbHeader hdr_header(const Bytes &b) {  // stbi__hdr_load
+    StbHeader h;
+    size_t at = 0;
+    auto line = [&] {  // stbi__hdr_gettoken: up to '\n', at most 1023 characters kept
+        std::string s;
+        while (at < b.s.size() && b[at] != '\n') {
+            if (s.size() < 1023) s += char(b[at]);
+            ++at;
+        }
+        ++at;
+        return s;
+    };
+    line();  // "#?RADIANCE" or "#?RGBE", as stb_format saw
+    bool rgbe = false;
+    for (std::string s; at < b.s.size() && !(s = line()).empty();) rgbe = rgbe || s == "FORMAT=32-bit_rle_rgbe";
+    const std::string size = line();
+    if (!rgbe || size.compare(0, 3, "-Y ") != 0) return h;  // refused by stb_image
+    char *end = nullptr;
+    h.height = int(std::strtol(size.c_str() + 3, &end, 10));
+    while (*end == ' ') ++end;
+    if (std::strncmp(end, "+X ", 3) != 0) return h;
+    h.width = int(std::strtol(end + 3, nullptr, 10));
+    if (h.width <= 0 || h.height <= 0) {
+        h.checked = true;
+        return h;
+    }
+    // Scan lines 8 to 32767 pixels wide may be run-length coded: a 4-byte mark (2, 2, width), then each of the
+    // 4 components as runs (2 bytes for up to 127 pixels) or literals. Otherwise (and when the first scan
+    // line has no mark, which makes stb_image read the whole image so) 4 bytes a pixel.
+    const uint64_t pixels = uint64_t(h.width) * uint64_t(h.height);
+    if (h.width >= 8 && h.width < 32768 && b[at] == 2 && b[at + 1] == 2 && !(b[at + 2] & 0x80)) {
+        h.need = at + uint64_t(h.height) * (4 + 4 * 2 * ((uint64_t(h.width) + 126) / 127));
+        h.exact = false;
+    } else {
+        h.need = at + 4 * pixels;
+    }
+    h.checked = true;
+    return h;
+}
+
+StbHeader pnm_header(const Bytes &b) {  // stbi__pnm_info and stbi__pnm_load (binary P5 gray, P6 RGB)
+    StbHeader h;
+    size_t at = 2;
+    unsigned c = b[at++];
+    auto skip_space = [&] {
+        for (;;) {
+            while (at <= b.s.size() && (c == ' ' || (c >= '\t' && c <= '\r'))) c = b[at++];
+            if (at > b.s.size() || c != '#') return;
+            while (at <= b.s.size() && c != '\n' && c != '\r') c = b[at++];
+        }
+    };
+    auto integer = [&] {
+        uint64_t v = 0;
+        while (at <= b.s.size() && c >= '0' && c <= '9') {
+            v = std::min<uint64_t>(v * 10 + (c - '0'), uint64_t(1) << 40);  // no overflow; stb_image refuses past 2^24
+            c = b[at++];
+        }
+        return v;
+    };
+    skip_space();
+    h.width = int64_t(integer());
+    skip_space();
+    h.height = int64_t(integer());
+    skip_space();
+    const uint64_t max_value = integer();
+    if (max_value > 65535) return h;  // refused by stb_image
+    // stb_image reads the header twice, the second time from its first buffer of 128 bytes again: a longer
+    // header (long comments) would be read the second time from other bytes of the file.
+    if (at > 128)
+        throw std::runtime_error(fmt::format("its PNM header is {} bytes long; stb_image reads at most 128", at));
+    h.sixteen_bit = max_value > 255;
+    h.need = at + uint64_t(h.width) * uint64_t(h.height) * (b[1] == '6' ? 3 : 1) * (h.sixteen_bit ? 2 : 1);
+    h.checked = true;
+    return h;
+}
+
 // stb_image reads a PNG's IDAT chunks into one buffer, grown to the size each chunk's header claims (up
 // to 2 GB) before the chunk is read, so a damaged length costs that allocation before the read fails (9 %
 // of fuzz_image's time once the OpenEXR headers were checked). This walks the chunks up to IEND (each a
 // 4-byte big-endian length, a 4-byte type, the data and a 4-byte CRC) and refuses one whose data the
-// file does not hold, which stb_image would fail on anyway. Not a PNG, or an early end: left to stb_image.
-void check_png_chunks(const std::string &path) {
-    static const unsigned char kSignature[8] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n'};
-    std::ifstream in(path, std::ios::binary);
-    std::error_code ec;
-    const uintmax_t file_size = std::filesystem::file_size(path, ec);
-    unsigned char b[8];
-    if (ec || !in.read(reinterpret_cast<char *>(b), 8) || std::memcmp(b, kSignature, 8) != 0) return;
-    for (uintmax_t at = 8; at + 8 <= file_size; ) {
-        if (!in.read(reinterpret_cast<char *>(b), 8)) return;
-        const uint32_t length = uint32_t(b[0]) << 24 | uint32_t(b[1]) << 16 | uint32_t(b[2]) << 8 | uint32_t(b[3]);
-        const std::string type(reinterpret_cast<const char *>(b + 4), 4);
-        if (type == "IEND") return;
+// file does not hold, which stb_image would fail on anyway. Then stb_image allocates the image IHDR asks
+// for (up to 1 GB, twice: the inflated rows, then the pixels) before it inflates the IDAT data: deflate
+// expands at most 1032 times (a 258-byte match for 2 bits), so IHDR asking for more bytes than the IDAT
+// data could inflate to is refused too.
+StbHeader png_header(const Bytes &b) {
+    StbHeader h;
+    const uint64_t file_size = b.s.size();
+    uint64_t idat = 0;
+    bool ihdr = false;
+    for (uint64_t at = 8; at + 8 <= file_size;) {
+        const uint32_t length = b.be32(at);
+        const std::string type = b.s.substr(at + 4, 4);
+        if (type == "IEND") break;
         at += 8;
         if (length > file_size - at)
-            fail(path, fmt::format("its PNG chunk '{}' claims {} bytes, but only {} bytes of the file follow it "
-                                   "(a damaged or truncated file)",
-                                   printable(type), length, file_size - at));
-        at += uintmax_t(length) + 4;
-        in.seekg(std::streamoff(at));
+            throw std::runtime_error(fmt::format("its PNG chunk '{}' claims {} bytes, but only {} bytes of the file "
+                                                 "follow it (a damaged or truncated file)",
+                                                 printable(type), length, file_size - at));
+        if (type == "IHDR" && !ihdr && length >= 13) {
+            ihdr = true;
+            h.width = b.be32(at), h.height = b.be32(at + 4);
+            const unsigned depth = b[at + 8], color = b[at + 9];
+            const unsigned channels = color == 2 ? 3 : color == 4 ? 2 : color == 6 ? 4 : 1;
+            h.sixteen_bit = depth == 16;
+            // At least the pixels' bits (a non-interlaced file adds a filter byte a row).
+            h.need = (uint64_t(h.width) * uint64_t(h.height) * channels * depth + 7) / 8;
+        }
+        if (type == "IDAT") idat += length;
+        at += uint64_t(length) + 4;
     }
+    if (!ihdr) return h;  // refused by stb_image
+    if (h.need > 1032 * idat + 1032)
+        throw std::runtime_error(fmt::format("its PNG header asks for {}x{} pixels ({} bytes), more than its {} bytes "
+                                             "of image data can inflate to (deflate expands at most 1032 times): a "
+                                             "damaged header or a truncated file",
+                                             h.width, h.height, h.need, idat));
+    h.need = 0;  // not a size of the file: the bound above is the check
+    h.exact = false;
+    h.checked = true;
+    return h;
 }
 
-bool stb_is_8_bit(const std::string &path) { return !stbi_is_hdr(path.c_str()) && !stbi_is_16_bit(path.c_str()); }
+// Reading through stbi_io_callbacks shows what reading from memory or a FILE hides: stb_image asking for
+// bytes past the file's end. It reads through its own 128-byte buffer (the first read, and every refill
+// after: a short read there is the file's end, a read of nothing is stb_image wanting more than the file
+// holds) or, for a block of pixels, straight into the image (stbi__getn, whose short read TGA, HDR and PNM
+// decoding ignore: the rest of the block would be garbage). Past the end it is given '\n' bytes, not the
+// zeros stb_image makes up itself: in a run-length coded HDR scan line a zero count never ends (stb_image
+// 2.27 loops forever on a file cut there), and a '\n' ends each HDR header line, so every loop ends. The
+// image is refused whenever past_end is set.
+struct StbInput {
+    const std::string *bytes;
+    size_t at = 0;
+    const char *buffer = nullptr;  // stb_image's own buffer: where its first read goes
+    bool past_end = false;
 
-ImageBytes read_stb_8_bit(const std::string &path) {
-    check_png_chunks(path);
+    static int read(void *user, char *data, int size) {
+        auto &in = *static_cast<StbInput *>(user);
+        if (!in.buffer) in.buffer = data;
+        const size_t left = in.at < in.bytes->size() ? in.bytes->size() - in.at : 0;
+        const size_t n = std::min(left, size_t(std::max(size, 0)));
+        std::memcpy(data, in.bytes->data() + in.at, n);
+        in.at += n;
+        if (n == size_t(std::max(size, 0)) || (n > 0 && data == in.buffer)) return int(n);
+        in.past_end = true;
+        std::memset(data + n, '\n', size_t(size) - n);
+        return size;
+    }
+    static void skip(void *user, int n) {
+        auto &in = *static_cast<StbInput *>(user);
+        in.at = n >= 0 ? in.at + size_t(n) : in.at - std::min(in.at, size_t(-int64_t(n)));
+    }
+    static int eof(void *user) {
+        auto &in = *static_cast<StbInput *>(user);
+        return in.at >= in.bytes->size();
+    }
+};
+
+// A file for stb_image, its format and header checked.
+struct StbFile {
+    std::string path, bytes;
+    StbFormat format = StbFormat::Unknown;
+    StbHeader header;
+};
+
+StbFile open_stb(const std::string &path) {
+    StbFile f;
+    f.path = path;
+    {
+        std::ifstream in(path, std::ios::binary | std::ios::ate);
+        if (!in) fail(path, "cannot open file");
+        const std::streamoff size = in.tellg();
+        // stb_image counts a file's bytes in an int.
+        if (size < 0 || size >= std::streamoff(INT32_MAX)) fail(path, "cannot read a file of 2 GB or more");
+        f.bytes.resize(size_t(size));
+        in.seekg(0);
+        if (!in.read(f.bytes.data(), size)) fail(path, "cannot read file");
+    }
+    const Bytes b{f.bytes};
+    f.format = stb_format(b);
+    switch (f.format) {
+        case StbFormat::Png: case StbFormat::Bmp: case StbFormat::Tga: case StbFormat::Hdr: case StbFormat::Pnm: break;
+        case StbFormat::Unknown:
+            fail(path, "not an image format neepp reads (OpenEXR, PNG, JPEG, Radiance HDR, TGA, BMP, binary PNM)");
+        case StbFormat::Jpeg: fail(path, "JPEG is read through libjpeg only");
+        default:  // stb_image would read these too, but they are no renderer's textures: not checked, not read
+            fail(path, fmt::format("{} images are not read (only OpenEXR, PNG, JPEG, Radiance HDR, TGA, BMP, "
+                                   "binary PNM)",
+                                   format_name(f.format)));
+    }
+    try {  // the header readers' errors say what is wrong; the path is added here
+        f.header = f.format == StbFormat::Png   ? png_header(b)
+                   : f.format == StbFormat::Bmp ? bmp_header(b)
+                   : f.format == StbFormat::Tga ? tga_header(b)
+                   : f.format == StbFormat::Hdr ? hdr_header(b)
+                                                : pnm_header(b);
+    } catch (const std::runtime_error &e) {
+        fail(path, e.what());
+    }
+    const StbHeader &h = f.header;
+    if (!h.checked) return f;
+    if (h.width <= 0 || h.height <= 0)
+        fail(path, fmt::format("its {} header gives a size of {}x{} pixels: no image", format_name(f.format), h.width,
+                               h.height));
+    if (h.need > f.bytes.size())
+        fail(path, fmt::format("its {} header asks for {}x{} pixels, which need {}{} bytes of the file, but it has {} "
+                               "(a truncated file or a damaged header)",
+                               format_name(f.format), h.width, h.height, h.exact ? "" : "at least ", h.need,
+                               f.bytes.size()));
+    return f;
+}
+
+// Runs an stb_image load through StbInput; fails naming the path if it read past the end or failed.
+template <typename Load>
+auto load_stb(const StbFile &f, Load load, int &w, int &h, int &n) {
+    StbInput in{&f.bytes};
+    static const stbi_io_callbacks callbacks{&StbInput::read, &StbInput::skip, &StbInput::eof};
+    auto *px = load(&callbacks, &in, &w, &h, &n, 0);
+    if (in.past_end) {
+        stbi_image_free(px);
+        fail(f.path, fmt::format("the file ends before its {} image data does (a truncated or damaged file)",
+                                 format_name(f.format)));
+    }
+    if (!px) fail_stb(f.path);
+    if (w <= 0 || h <= 0 || n < 1 || n > 4) {
+        stbi_image_free(px);
+        fail(f.path, fmt::format("stb_image read it as {}x{} pixels of {} channels: no image", w, h, n));
+    }
+    return px;
+}
+
+bool is_8_bit(const StbFile &f) { return f.format != StbFormat::Hdr && !f.header.sixteen_bit; }
+
+ImageBytes read_stb_8_bit(const StbFile &f) {
     int w = 0, h = 0, n = 0;
-    stbi_uc *px = stbi_load(path.c_str(), &w, &h, &n, 0);
-    if (!px) fail_stb(path);
+    stbi_uc *px = load_stb(f, stbi_load_from_callbacks, w, h, n);
     ImageBytes img;
     img.width = w, img.height = h, img.channels = n;
     img.data.assign(px, px + size_t(w) * h * n);
@@ -311,17 +665,14 @@ ImageBytes read_stb_8_bit(const std::string &path) {
 }
 
 // stbi_loadf is avoided for integer files: it applies a gamma-2.2 curve instead of keeping the codes.
-Image read_stb(const std::string &path) {
-    check_png_chunks(path);
-    const char *p = path.c_str();
+Image read_stb(const StbFile &f) {
     int w = 0, h = 0, n = 0;
-    if (stbi_is_hdr(p)) {
-        if (float *px = stbi_loadf(p, &w, &h, &n, 0)) return image_from_stb(px, w, h, n, 1.f, false);
-    } else if (stbi_is_16_bit(p)) {
-        if (stbi_us *px = stbi_load_16(p, &w, &h, &n, 0))
-            return image_from_stb(px, w, h, n, 1.f / 65535.f, true);
+    if (f.format == StbFormat::Hdr) {
+        float *px = load_stb(f, stbi_loadf_from_callbacks, w, h, n);
+        return image_from_stb(px, w, h, n, 1.f, false);
     }
-    fail_stb(path);
+    stbi_us *px = load_stb(f, stbi_load_16_from_callbacks, w, h, n);
+    return image_from_stb(px, w, h, n, 1.f / 65535.f, true);
 }
 
 // 8-bit codes as Image's normalized floats. Multiplying by the reciprocal (not dividing) reproduces
@@ -349,27 +700,31 @@ void check_writable(const std::string &path, const Image &img) {
 
 }  // namespace
 
-namespace {
-
-std::optional<ImageBytes> read_bytes(const std::string &path, FileKind kind) {
-    switch (kind) {
+std::optional<ImageBytes> read_image_bytes(const std::string &path) {
+    switch (kind_of(path)) {
         case FileKind::Exr: return std::nullopt;
 #ifdef NEEPP_HAVE_LIBJPEG
         case FileKind::Jpeg: return read_jpeg(path);
 #endif
-        default: return stb_is_8_bit(path) ? std::optional<ImageBytes>(read_stb_8_bit(path)) : std::nullopt;
+        default: {
+            const StbFile f = open_stb(path);
+            if (!is_8_bit(f)) return std::nullopt;
+            return read_stb_8_bit(f);
+        }
     }
 }
 
-}  // namespace
-
-std::optional<ImageBytes> read_image_bytes(const std::string &path) { return read_bytes(path, kind_of(path)); }
-
 Image read_image(const std::string &path) {
-    const FileKind kind = kind_of(path);
-    if (kind == FileKind::Exr) return read_exr(path);
-    if (std::optional<ImageBytes> bytes = read_bytes(path, kind)) return image_from_bytes(*bytes);
-    return read_stb(path);
+    switch (kind_of(path)) {
+        case FileKind::Exr: return read_exr(path);
+#ifdef NEEPP_HAVE_LIBJPEG
+        case FileKind::Jpeg: return image_from_bytes(read_jpeg(path));
+#endif
+        default: {
+            const StbFile f = open_stb(path);
+            return is_8_bit(f) ? image_from_bytes(read_stb_8_bit(f)) : read_stb(f);
+        }
+    }
 }
 
 std::vector<std::string> channel_names(int channels) {

@@ -29,10 +29,13 @@ struct Image {
 // The largest side of an image read or rendered (a film's, an OpenEXR file's data window): refused beyond.
 constexpr int kMaxImageSide = 1 << 15;
 
-// Reads EXR (linear; half or float; R,G,B[,A] or Y[,A] channels), PNG, JPEG, HDR, TGA, BMP. The format
-// is detected from the file's contents, not its name. Integer formats come back normalized to [0,1]
-// (byte * (1/255), as Dr.Jit's texture does) with srgb_encoded = true, as Mitsuba marks them (16-bit
-// PNG included); the caller decides whether to linearize (Mitsuba's `raw` flag). Alpha is kept.
+// Reads EXR (linear; half or float; R,G,B[,A] or Y[,A] channels), PNG, JPEG, HDR, TGA, BMP and binary PNM
+// (P5, P6). The format is detected from the file's contents, not its name; other formats stb_image knows
+// (GIF, PSD, PIC) are refused. A file shorter than its header says (truncated), or whose header asks for
+// more pixels than its bytes can hold, is refused before its pixels are allocated, never read as zeros.
+// Integer formats come back normalized to [0,1] (byte * (1/255), as Dr.Jit's texture does) with
+// srgb_encoded = true, as Mitsuba marks them (16-bit PNG included); the caller decides whether to
+// linearize (Mitsuba's `raw` flag). Alpha is kept.
 // Throws std::runtime_error naming the path on any failure.
 Image read_image(const std::string &path);
 
@@ -43,7 +46,7 @@ struct ImageBytes {
     std::vector<uint8_t> data;  // row-major, top row first, interleaved channels
     int color_channels() const { return channels == 2 || channels == 4 ? channels - 1 : channels; }  // 1 or 3
 };
-// JPEG and 8-bit PNG, TGA, BMP as their codes; std::nullopt for the files read_image reads as floats
+// JPEG and 8-bit PNG, TGA, BMP, PNM as their codes; std::nullopt for the files read_image reads as floats
 // (OpenEXR, HDR, 16-bit). Throws as read_image does.
 std::optional<ImageBytes> read_image_bytes(const std::string &path);
 
