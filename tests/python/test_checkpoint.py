@@ -33,6 +33,22 @@ def wait_for(path: Path, timeout: float):
         time.sleep(0.05)
 
 
+_uninterrupted: dict = {}
+
+
+def uninterrupted(neepp_bin, tmp_path, spp, *extra, scene=DEMO):
+    """The image and statistics of the render run through without a stop: rendered once per set of arguments
+    in this module (the path SIGKILL and SIGTERM cases share theirs, as do the learning light sampler's two),
+    since a render is the same to the bit for the same arguments and thread count."""
+    key = (spp, tuple(map(str, extra)), str(scene))
+    if key not in _uninterrupted:
+        ref = tmp_path / "ref.exr"
+        subprocess.run(args(neepp_bin, ref, spp, *extra, "--stats", tmp_path / "ref.json", scene=scene), check=True,
+                       timeout=300)
+        _uninterrupted[key] = read_exr(ref), json.loads((tmp_path / "ref.json").read_text())
+    return _uninterrupted[key]
+
+
 @pytest.mark.parametrize("integrator, spp, sig, options", [
     ("path", 300, signal.SIGKILL, []),
     ("bdpt", 100, signal.SIGKILL, []),  # passes of 1, 32, 32, 32, 3 spp: the kill lands inside the third
@@ -42,9 +58,8 @@ def wait_for(path: Path, timeout: float):
     ("pssmlt", 40, signal.SIGTERM, ["-I", "shadow_rays=neepp"]),  # a pass cut short: its mutations are undone
 ])
 def test_a_stopped_render_resumes_to_the_uninterrupted_image(neepp_bin, tmp_path, integrator, spp, sig, options):
-    ref, out = tmp_path / "ref.exr", tmp_path / "out.exr"
-    subprocess.run(args(neepp_bin, ref, spp, "--integrator", integrator, *options, "--stats", tmp_path / "ref.json"),
-                   check=True, timeout=300)
+    out = tmp_path / "out.exr"
+    ref_image, ref_stats = uninterrupted(neepp_bin, tmp_path, spp, "--integrator", integrator, *options)
     checkpoint = Path(str(out) + ".checkpoint")
     p = subprocess.Popen(args(neepp_bin, out, spp, "--integrator", integrator, *options, "--checkpoint", 0.2,
                               "--stats", tmp_path / "first.json"))
@@ -61,9 +76,8 @@ def test_a_stopped_render_resumes_to_the_uninterrupted_image(neepp_bin, tmp_path
     assert 1 <= s["resumed_spp"] < spp and s["spp"] == spp and s["stopped_by"] == "spp"
     if sig == signal.SIGTERM:  # stopped cleanly: its last checkpoint is where it stopped
         assert s["resumed_spp"] == json.loads((tmp_path / "first.json").read_text())["spp"]
-    assert np.array_equal(read_exr(out), read_exr(ref))
+    assert np.array_equal(read_exr(out), ref_image)
     # The counters continue too: a pass cut short by the stop is in neither the image nor the counts.
-    ref_stats = json.loads((tmp_path / "ref.json").read_text())
     for key in ("rays", "shadow_rays", "light_rays", "splats"):
         assert s[key] == ref_stats[key], key
     assert not checkpoint.exists()  # a finished render needs it no more
@@ -73,9 +87,9 @@ def test_a_stopped_render_resumes_to_the_uninterrupted_image(neepp_bin, tmp_path
 def test_a_learning_light_sampler_resumes_to_the_uninterrupted_image(neepp_bin, tmp_path, sig):
     """light_sampler=bayes learns from NEE's samples between passes: its statistics travel in the checkpoint."""
     opts, spp = ["-I", "light_sampler=bayes"], 96
-    ref, out = tmp_path / "ref.exr", tmp_path / "out.exr"
-    subprocess.run(args(neepp_bin, ref, spp, *opts, "--stats", tmp_path / "ref.json", scene=OFFICE), check=True, timeout=300)
-    learned = json.loads((tmp_path / "ref.json").read_text())["integrator_statistics"]["light_sampler"]
+    out = tmp_path / "out.exr"
+    ref_image, ref_stats = uninterrupted(neepp_bin, tmp_path, spp, *opts, scene=OFFICE)
+    learned = ref_stats["integrator_statistics"]["light_sampler"]
     assert learned["used"] == "bayes" and learned["samples_learned"] > 0 and learned["passes"] > 2
     checkpoint = Path(str(out) + ".checkpoint")
     p = subprocess.Popen(args(neepp_bin, out, spp, *opts, "--checkpoint", 0.2, scene=OFFICE))
@@ -88,7 +102,7 @@ def test_a_learning_light_sampler_resumes_to_the_uninterrupted_image(neepp_bin, 
     assert r.returncode == 0, r.stderr
     s = json.loads((tmp_path / "s.json").read_text())
     assert 1 <= s["resumed_spp"] < spp and s["spp"] == spp
-    assert np.array_equal(read_exr(out), read_exr(ref))
+    assert np.array_equal(read_exr(out), ref_image)
 
 
 @pytest.mark.parametrize("change, expect", [(["--seed", "6"], "its seed is 5"),
