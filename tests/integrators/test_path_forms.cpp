@@ -10,13 +10,13 @@
 // in most paths it touches, and fails the first check.
 #include <gtest/gtest.h>
 #include <cmath>
-#include <filesystem>
 #include "neepp/base/ray_batch.h"
 #include "neepp/io/image.h"
 #include "neepp/sampling/sampler.h"
 #include "neepp/scene/scene.h"
 #include "../light_selection/light_test_scenes.h"
 #include "../visibility/visibility_test_scenes.h"
+#include "common/seeded_map.h"
 #include "test_scenes.h"
 
 using namespace neepp;
@@ -109,23 +109,6 @@ const std::vector<OptionMap> kOptionSets = {
     {{"ris", "8"}, {"ris_depth", "3"}, {"shadow_rays", "neepp"}, {"light_sampler", "power"}},
 };
 
-// The options, and where the integrator keeps a NEE++ map, the file it is read from (or, the first time,
-// seeded into): a map is seeded from the scene and the grid alone (the render's seed, the form and these
-// options do not enter it), so every render of a scene may start from the one seeded map. Seeding it again
-// for each render took most of these tests' time; an integrator that reads the map from the file renders
-// every image and sample here as the one that seeded it does, to the bit. Integrators without a map refuse
-// the option as unused.
-OptionMap with_map_file(const OptionMap &o, const std::string &scene_path) {
-    OptionMap m = o;
-    m["visibility_map"] = (std::filesystem::path(scene_path).parent_path() / "seeded.map").string();
-    try {
-        make_integrator("path", Options(m));
-    } catch (const std::invalid_argument &) {
-        return o;
-    }
-    return m;
-}
-
 std::string describe(const Family &f, const OptionMap &o) {
     std::string s = f.name;
     for (const auto &[k, v] : o) s += " " + k + "=" + v;
@@ -142,7 +125,9 @@ struct SampleAgreement {
 // its rejection decided, what it learned merged).
 SampleAgreement compare_samples(const std::string &scene_path, const OptionMap &o) {
     auto scene = load_scene(scene_path);
-    auto integrator = make_integrator("path", with_scene_options(*scene, Options(with_map_file(o, scene_path))));
+    // Every integrator with a map starts from the one the scene's first seeded (common/seeded_map.h).
+    const OptionMap options = with_map_file(o, map_file_beside(scene_path));
+    auto integrator = make_integrator("path", with_scene_options(*scene, Options(options)));
     RenderJob warm_up;
     warm_up.spp = 3;
     warm_up.seed = 11;
@@ -253,7 +238,7 @@ TEST(PathForms, SameImageInExpectation) {
     for (auto [family, o] : cases) {
         const std::string what = describe(kFamilies[family], o);
         const std::string path = write_temp_scene(kFamilies[family].xml());
-        o = with_map_file(o, path);  // the eight renders of a case (both forms) seed one map
+        o = with_map_file(o, map_file_beside(path));  // the eight renders of a case (both forms) seed one map
         const BlockMoments fast = block_moments(path, "path", Options(o), 4, 16, 101);
         o["form"] = "reference";
         const BlockMoments reference = block_moments(path, "path", Options(o), 4, 16, 202);
