@@ -125,26 +125,49 @@ Chi2Result chi2_sphere_test(const DirectionSampler &sample, const DirectionPdf &
 
     Chi2Result res;
     double valid_fraction = double(valid) / double(cfg.sample_count);
-    // Simpson's rule in (phi, cos theta); the solid-angle measure is dphi dcos.
+    // Simpson's rule in (phi, cos theta); the solid-angle measure is dphi dcos. A bin's last node in either
+    // coordinate is its neighbour's first (i + m/m is (i + 1) + 0/m, exactly), so the density is evaluated
+    // once per node of the whole grid, a row of nodes of constant cos theta at a time, and each bin sums
+    // its (m + 1)^2 nodes' values in the order and with the weights it always did: the same expected counts,
+    // to the bit, for about 1/8 fewer evaluations of the density and none of the sines and cosines again.
     const int m = cfg.ires;
     auto simpson_weight = [m](int k) { return (k == 0 || k == m) ? 1.0 : (k % 2 ? 4.0 : 2.0); };
+    // Node k of a grid of bins of m subintervals each: bin k / m's node k % m (the last, the last bin's m).
+    auto node = [m](int k, int bins) {
+        const int bin = std::min(k / m, bins - 1);
+        return double(bin) + double(k - bin * m) / m;
+    };
+    const int phi_nodes = n_phi * m + 1;
+    std::vector<double> cos_phi(phi_nodes), sin_phi(phi_nodes);
+    for (int k = 0; k < phi_nodes; ++k) {
+        const double phi = -M_PI + d_phi * node(k, n_phi);
+        cos_phi[k] = std::cos(phi);
+        sin_phi[k] = std::sin(phi);
+    }
+    // rows[b][k]: the density at the band's node b in cos theta (of the bins j) and node k in phi.
+    std::vector<std::vector<double>> rows(m + 1, std::vector<double>(phi_nodes));
+    auto fill_row = [&](std::vector<double> &row, int k_cos) {
+        const double cos_t = std::clamp(cfg.cos_min + d_cos * node(k_cos, n_cos), -1.0, 1.0);
+        const double sin_t = std::sqrt(std::max(0.0, 1.0 - cos_t * cos_t));
+        for (int k = 0; k < phi_nodes; ++k) {
+            Vec3 w(float(sin_t * cos_phi[k]), float(sin_t * sin_phi[k]), float(cos_t));
+            row[k] = pdf(cfg.frame.to_world(w));
+        }
+    };
     double pdf_integral = 0;
-    for (int j = 0; j < n_cos; ++j)
+    for (int j = 0; j < n_cos; ++j) {
+        if (j == 0) fill_row(rows[0], 0);
+        else std::swap(rows[0], rows[m]);
+        for (int b = 1; b <= m; ++b) fill_row(rows[b], j * m + b);
         for (int i = 0; i < n_phi; ++i) {
             double sum = 0;
-            for (int b = 0; b <= m; ++b) {
-                double cos_t = std::clamp(cfg.cos_min + d_cos * (j + double(b) / m), -1.0, 1.0);
-                double sin_t = std::sqrt(std::max(0.0, 1.0 - cos_t * cos_t));
-                for (int a = 0; a <= m; ++a) {
-                    double phi = -M_PI + d_phi * (i + double(a) / m);
-                    Vec3 w(float(sin_t * std::cos(phi)), float(sin_t * std::sin(phi)), float(cos_t));
-                    sum += simpson_weight(a) * simpson_weight(b) * pdf(cfg.frame.to_world(w));
-                }
-            }
+            for (int b = 0; b <= m; ++b)
+                for (int a = 0; a <= m; ++a) sum += simpson_weight(a) * simpson_weight(b) * rows[b][i * m + a];
             double integral = sum * (d_phi / (3.0 * m)) * (d_cos / (3.0 * m));
             expected[j * n_phi + i] = integral * double(cfg.sample_count);
             pdf_integral += integral;
         }
+    }
 
     if (outside > 0) {
         res.error = std::to_string(outside) + " samples outside the binned band";

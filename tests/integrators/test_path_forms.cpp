@@ -16,6 +16,7 @@
 #include "neepp/scene/scene.h"
 #include "../light_selection/light_test_scenes.h"
 #include "../visibility/visibility_test_scenes.h"
+#include "common/seeded_map.h"
 #include "test_scenes.h"
 
 using namespace neepp;
@@ -122,9 +123,11 @@ struct SampleAgreement {
 // The camera samples of the first kSamples pixel samples, each with its own sampler, evaluated by both
 // forms of one integrator after a short render has taken it through its first passes (NEE++'s map seeded,
 // its rejection decided, what it learned merged).
-SampleAgreement compare_samples(const Family &family, const OptionMap &o) {
-    auto scene = load_scene(write_temp_scene(family.xml()));
-    auto integrator = make_integrator("path", with_scene_options(*scene, Options(o)));
+SampleAgreement compare_samples(const std::string &scene_path, const OptionMap &o) {
+    auto scene = load_scene(scene_path);
+    // Every integrator with a map starts from the one the scene's first seeded (common/seeded_map.h).
+    const OptionMap options = with_map_file(o, map_file_beside(scene_path));
+    auto integrator = make_integrator("path", with_scene_options(*scene, Options(options)));
     RenderJob warm_up;
     warm_up.spp = 3;
     warm_up.seed = 11;
@@ -170,11 +173,12 @@ SampleAgreement compare_samples(const Family &family, const OptionMap &o) {
 
 TEST(PathForms, SameRadianceSampleBySample) {
     int samples = 0, disagree = 0;
-    for (const Family &family : kFamilies)
+    for (const Family &family : kFamilies) {
+        const std::string scene_path = write_temp_scene(family.xml());
         for (const OptionMap &o : kOptionSets) {
             const std::string what = describe(family, o);
             SCOPED_TRACE(what);
-            const SampleAgreement a = compare_samples(family, o);
+            const SampleAgreement a = compare_samples(scene_path, o);
             std::printf("%-70s %3d of %d close, %3d to the bit, %3d lit; rays %llu / %llu, shadow rays %llu / %llu\n",
                         what.c_str(), a.close, a.samples, a.exact, a.nonzero, (unsigned long long)a.fast.rays,
                         (unsigned long long)a.reference.rays, (unsigned long long)a.fast.shadow_rays,
@@ -189,6 +193,7 @@ TEST(PathForms, SameRadianceSampleBySample) {
             EXPECT_NEAR(double(a.fast.rays), double(a.reference.rays), 0.01 * double(a.reference.rays));
             EXPECT_NEAR(double(a.fast.shadow_rays), double(a.reference.shadow_rays), 0.01 * double(a.reference.shadow_rays) + 2);
         }
+    }
     // An error on a rare kind of path (a weight wrong only for some emitters hit) may stay under the
     // per-case bound; summed over every case it does not.
     EXPECT_LE(disagree, samples / 1000) << disagree << " of " << samples << " samples disagree";
@@ -233,6 +238,7 @@ TEST(PathForms, SameImageInExpectation) {
     for (auto [family, o] : cases) {
         const std::string what = describe(kFamilies[family], o);
         const std::string path = write_temp_scene(kFamilies[family].xml());
+        o = with_map_file(o, map_file_beside(path));  // the eight renders of a case (both forms) seed one map
         const BlockMoments fast = block_moments(path, "path", Options(o), 4, 16, 101);
         o["form"] = "reference";
         const BlockMoments reference = block_moments(path, "path", Options(o), 4, 16, 202);
