@@ -42,8 +42,15 @@ const OptionMap kGuided = {{"guiding", "sdtree"}};
 TEST(PathGuiding, OptionIsPathsAndRefusedElsewhere) {
     auto guided = make_integrator("path", Options(kGuided));
     EXPECT_EQ(guided->describe()["guiding"], "sdtree");
-    EXPECT_EQ(guided->describe()["form"], "reference") << "guiding renders with the reference form";
-    EXPECT_EQ(dynamic_cast<RayIntegrator &>(*guided).batch(), nullptr);
+    EXPECT_EQ(guided->describe()["form"], "fast") << "both forms guide; the fast one by default";
+    EXPECT_NE(dynamic_cast<RayIntegrator &>(*guided).batch(), nullptr);
+    OptionMap reference = kGuided;
+    reference["form"] = "reference";
+    EXPECT_EQ(dynamic_cast<RayIntegrator &>(*make_integrator("path", Options(reference))).batch(), nullptr);
+    EXPECT_THROW(make_integrator("path", Options(OptionMap{{"guiding", "sdtree"}, {"guiding_bsdf_fraction", "0"}})),
+                 std::invalid_argument) << "a guide alone could miss directions the BSDF reaches";
+    EXPECT_THROW(make_integrator("path", Options(OptionMap{{"guiding", "sdtree"}, {"guiding_spatial_threshold", "-1"}})),
+                 std::invalid_argument);
     EXPECT_EQ(make_integrator("path", Options())->describe()["guiding"], "none");
     EXPECT_NE(dynamic_cast<RayIntegrator &>(*make_integrator("path", Options(OptionMap{{"guiding", "none"}}))).batch(), nullptr);
     EXPECT_THROW(make_integrator("path", Options(OptionMap{{"guiding", "ppg"}})), std::invalid_argument);

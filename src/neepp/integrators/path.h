@@ -39,10 +39,16 @@ struct PathOptions {
     // and shadow rays that pass such surfaces and media with their transmittance. Reference form only.
     bool volumetric = false;
     // Practical path guiding (guiding=sdtree, path_guiding.h): at vertices without a delta BSDF part the
-    // next direction is drawn by one-sample MIS between the BSDF (this share) and an SD-tree learned from
-    // the passes before; NEE stays for direct light. Rendered by the reference form.
+    // next direction is drawn by one-sample MIS between the BSDF (guiding_bsdf_fraction of the samples) and
+    // an SD-tree learned from the passes before; NEE stays for direct light. Both forms render it.
     bool guiding = false;
-    static constexpr float kGuidingBsdfFraction = 0.5f;  // PPG's
+    float guiding_bsdf_fraction = 0.5f;  // PPG's
+    // The SD-tree's spatial threshold c (SDTreeOptions::spatial_threshold); 0: scaled to the image
+    // (sd_tree.h).
+    double guiding_spatial_threshold = 12000;
+    // What a guided vertex's record holds: all the radiance its direction brought (true), or that less the
+    // emission the direction found directly (false: the light next event estimation also samples).
+    bool guiding_learn_direct = true;
 };
 
 class PathBatch;

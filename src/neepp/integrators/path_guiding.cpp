@@ -49,7 +49,7 @@ void GuideRecorder::commit(SDTree &tree, const Color &L) const {
         // Per channel, where the throughput lets the channel through; the tree keeps their mean.
         double arrived = 0;
         for (int c = 0; c < 3; ++c)
-            if (v.beta[c] > 0) arrived += double(L[c] - v.L[c]) / double(v.beta[c]);
+            if (v.beta[c] > 0) arrived += double(L[c] - v.L[c] - v.direct[c]) / double(v.beta[c]);
         tree.record(v.p, v.d, std::max(arrived, 0.0) / 3.0 / double(v.pdf));
     }
 }

@@ -55,17 +55,26 @@ BSDFSample sample_guided(const VertexGuide &g, const BSDF &bsdf, const SurfaceIn
 // that arrived along the direction, and that over the direction's density is PPG's record.
 class GuideRecorder {
 public:
-    void add(const Vec3 &p, const Vec3 &d, float pdf, const Color &beta, const Color &L) {
-        if (n_ < int(v_.size())) v_[n_++] = {p, d, pdf, beta, L};
+    // The vertex at path depth `depth` (the camera's first hit is 0).
+    void add(int depth, const Vec3 &p, const Vec3 &d, float pdf, const Color &beta, const Color &L) {
+        if (n_ < int(v_.size())) v_[n_++] = {p, d, pdf, beta, L, Color(0.f), depth};
+    }
+    // Emission that the direction chosen at depth `depth` found directly, as the path gathered it (its
+    // MIS weight included): left out of that vertex's record when the guide learns only the light that
+    // next event estimation does not bring (PathOptions::guiding_learn_direct false).
+    void found_emission(int depth, const Color &contribution) {
+        if (n_ > 0 && v_[n_ - 1].depth == depth) v_[n_ - 1].direct += contribution;
     }
     // Records every vertex into the tree, L being all the path gathered.
     void commit(SDTree &tree, const Color &L) const;
+    void clear() { n_ = 0; }
 
 private:
     struct Vertex {
         Vec3 p, d;
         float pdf;
-        Color beta, L;
+        Color beta, L, direct;
+        int depth;
     };
     std::array<Vertex, 64> v_;  // longer paths record their first 64 vertices
     int n_ = 0;
