@@ -125,12 +125,15 @@ TEST(PathGuiding, UnbiasedWithAWrongGuide) {
     auto scene = load_scene(path);
     const BlockMoments nee = block_moments(path, "path", Options(), 6, 64, 101);
     // Into the floor (the guide's share of the samples is then mostly wasted), and away from the light.
+    // Most samples from the wrong guide (the default leaves it a quarter), so that its errors would show.
+    OptionMap guided = kGuided;
+    guided["guiding_bsdf_fraction"] = "0.25";
     const SDTree down = cone_guide(scene->bounds(), Vec3(0, -1, 0));
     ASSERT_TRUE(down.can_guide(down.leaf_at(Vec3(0.f, 1.f, 0.f))));
     ASSERT_LT(down.pdf(down.leaf_at(Vec3(0.f, 1.f, 0.f)), Vec3(0, 1, 0)), 1e-3f) << "nothing guided upward";
-    expect_same_image(nee, guided_moments(path, kGuided, 6, 64, 404, &down), "guide pointing down");
+    expect_same_image(nee, guided_moments(path, guided, 6, 64, 404, &down), "guide pointing down");
     const SDTree back = cone_guide(scene->bounds(), Vec3(0, 0, 1));
-    expect_same_image(nee, guided_moments(path, kGuided, 6, 64, 505, &back), "guide pointing out of the room");
+    expect_same_image(nee, guided_moments(path, guided, 6, 64, 505, &back), "guide pointing out of the room");
     // A guide learned on another scene (its cube elsewhere: points map to its nearest leaves).
     auto other_scene = load_scene(write_temp_scene(kGlossyRoomXml));
     auto other = make_integrator("path", with_scene_options(*other_scene, Options(kGuided)));
@@ -138,7 +141,7 @@ TEST(PathGuiding, UnbiasedWithAWrongGuide) {
     job.spp = 16;
     render(*other_scene, *other, job);
     const SDTree learned_elsewhere = *dynamic_cast<const PathIntegrator &>(*other).guide();
-    expect_same_image(nee, guided_moments(path, kGuided, 6, 64, 606, &learned_elsewhere), "guide of another scene");
+    expect_same_image(nee, guided_moments(path, guided, 6, 64, 606, &learned_elsewhere), "guide of another scene");
 }
 
 TEST(PathGuiding, SameImageToTheBitForASeedAndThreadCount) {

@@ -60,7 +60,7 @@ std::vector<IntegratorDoc> make_docs() {
                             "definition: the same image in expectation, slower)", ""});
     path.options.push_back({"guiding", "none",
                             "none, or sdtree: practical path guiding (Mueller et al. 2017), an SD-tree learned from "
-                            "each pass's paths guides the next direction by one-sample MIS with the BSDF (half each) "
+                            "each pass's paths guides the next direction by one-sample MIS with the BSDF "
                             "where the BSDF has no delta part; unbiased whatever it learned", ""});
     path.options.push_back({"guiding_bsdf_fraction", text(p.guiding_bsdf_fraction),
                             "guiding=sdtree: the share of next directions the BSDF samples (the rest the guide), "
