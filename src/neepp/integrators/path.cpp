@@ -147,8 +147,7 @@ struct PathIntegrator::LightCandidate {
 };
 
 Color PathIntegrator::sample_direct(const Scene &scene, const SurfaceInteraction &si, const LightSampleContext &ctx,
-                                    const Color &beta, int M, Sampler &sampler, RenderCounters &counters,
-                                    const VertexGuide &guide) const {
+                                    const Color &beta, int M, Sampler &sampler, RenderCounters &counters) const {
     const BSDF &bsdf = *si.shape->bsdf;
     // M candidates, each a light chosen by the light sampler and a point on it, by the light's own sampling
     // or within_light's. Without resampling (M = 1) the one candidate is the sample.
@@ -199,7 +198,7 @@ Color PathIntegrator::sample_direct(const Scene &scene, const SurfaceInteraction
     }
     // MIS against BSDF sampling, by the light strategy's source density (see emission_weight).
     const float light_pdf = y.ds.pdf * y.light.pmf;
-    const float w_mis = y.ds.delta ? 1.f : mis_power(light_pdf, guide.pdf(y.ds.d, bsdf_pdf));
+    const float w_mis = y.ds.delta ? 1.f : mis_power(light_pdf, bsdf_pdf);
     // The shadow-ray component decides whether to trace (NEE++: with probability q, weight 1/q) and traces.
     ShadowQuery q;
     q.ray = y.ds.dist >= kInfinity ? si.spawn_ray(y.ds.d) : si.spawn_ray_to(y.ds.p);
@@ -264,20 +263,21 @@ Color PathIntegrator::Li(const Scene &scene, const Ray &camera_ray, Sampler &sam
         const LightSampleContext ctx = light_context(si, ray.d);
         const VertexGuide guide = guide_at(guide_.get(), guide_learns_, si, options_.guiding_bsdf_fraction);
         if (options_.nee && (si.shape->bsdf_flags & BSDFSmooth))
-            L += sample_direct(scene, si, ctx, beta, candidates_at(depth), sampler, counters, guide);
+            L += sample_direct(scene, si, ctx, beta, candidates_at(depth), sampler, counters);
 
         // The next direction: by the BSDF, or where a guide has learned, by the BSDF or the guide.
         const BSDF &bsdf = *si.shape->bsdf;
         const float u_choice = guide.tree ? sampler.next_1d() : 0.f;
         const float u1 = sampler.next_1d();
         const Vec2 u2 = sampler.next_2d();
-        const BSDFSample bs = guide.tree ? sample_guided(guide, bsdf, si, u_choice, u1, u2)
+        float own_pdf = 0.f;  // the BSDF's density of a guided sample, for MIS (sample_guided)
+        const BSDFSample bs = guide.tree ? sample_guided(guide, bsdf, si, u_choice, u1, u2, own_pdf)
                                          : bsdf.sample(BSDFContext{}, si, si.wi, u1, u2);
         if (!bs.valid()) break;
         beta *= bs.weight;
         eta *= bs.eta;
         prev = ctx;
-        prev_bsdf_pdf = bs.pdf;
+        prev_bsdf_pdf = guide.tree ? own_pdf : bs.pdf;
         prev_delta = (bs.sampled_flags & BSDFDelta) != 0;
         ray = si.spawn_ray(si.to_world(bs.wo));
 

@@ -108,10 +108,9 @@ private:
     // Next event estimation at a scattering vertex (pbrt-v4's SampleLd): a light sample, or with ris > 1
     // one of M resampled ones, tested by the shadow-ray component; the contribution already multiplied by
     // the path throughput beta, which contribution-aware shadow-ray policies need to see.
-    // With a guide, the BSDF strategy's density in the MIS weight is the guided mixture's.
+    // With a guide, the BSDF strategy's density in the MIS weight is still the BSDF's own (sample_guided).
     Color sample_direct(const Scene &scene, const SurfaceInteraction &si, const LightSampleContext &ctx,
-                        const Color &beta, int M, Sampler &sampler, RenderCounters &counters,
-                        const VertexGuide &guide) const;
+                        const Color &beta, int M, Sampler &sampler, RenderCounters &counters) const;
     // MIS weight for emission found by a BSDF-sampled ray leaving prev (pdf prev_pdf) toward light.
     float emission_weight(const Light &light, const LightSampleContext &prev, const DirectionSample &ds,
                           float prev_pdf) const;

@@ -244,8 +244,8 @@ bool PathBatch::begin_direct(Path &path) const {
     }
     if (learner) path.learn = luminance(f * Le) / ds.pdf;
     float light_pdf = ds.pdf * sl.pmf;
-    // See emission_weight; with a guide, the BSDF strategy's density is the guided mixture's.
-    float w = ds.delta ? 1.f : mis_power(light_pdf, path.guide.pdf(ds.d, bsdf_pdf));
+    // See emission_weight; with a guide too, the BSDF strategy's density is the BSDF's own (sample_guided).
+    float w = ds.delta ? 1.f : mis_power(light_pdf, bsdf_pdf);
     ShadowQuery &q = path.shadow = ShadowQuery{};  // nothing the policy kept from the last bounce
     q.ray = ds.dist >= kInfinity ? si.spawn_ray(ds.d) : si.spawn_ray_to(ds.p);
     q.from = si.p;
@@ -290,12 +290,14 @@ bool PathBatch::finish_vertex(Path &path) const {
     const float u_choice = guide.tree ? sampler.next_1d() : 0.f;  // in Li's order
     float u1 = sampler.next_1d();
     Vec2 u2 = sampler.next_2d();
-    BSDFSample bs = guide.tree ? sample_guided(guide, bsdf, si, u_choice, u1, u2) : bsdf.sample(BSDFContext{}, si, si.wi, u1, u2);
+    float own_pdf = 0.f;  // the BSDF's density of a guided sample, for MIS (sample_guided)
+    BSDFSample bs = guide.tree ? sample_guided(guide, bsdf, si, u_choice, u1, u2, own_pdf)
+                               : bsdf.sample(BSDFContext{}, si, si.wi, u1, u2);
     if (!bs.valid()) return false;
     path.beta *= bs.weight;
     path.eta *= bs.eta;
     path.prev = path.ctx;
-    path.prev_bsdf_pdf = bs.pdf;
+    path.prev_bsdf_pdf = guide.tree ? own_pdf : bs.pdf;
     path.prev_delta = (bs.sampled_flags & BSDFDelta) != 0;
     path.ray = si.spawn_ray(si.to_world(bs.wo));
     ++path.depth;

@@ -35,7 +35,7 @@ struct VertexGuide {
         return fold && dot(d, up) < 0 ? mirror(d, up) : d;
     }
     // The density with which the vertex samples world direction d, the BSDF's own density being bsdf_pdf:
-    // what weighs the sample, and what MIS against next event estimation must see as the BSDF strategy's.
+    // what weighs the sample.
     float pdf(const Vec3 &d, float bsdf_pdf) const {
         return tree ? bsdf_fraction * bsdf_pdf + (1.f - bsdf_fraction) * guide_pdf(d) : bsdf_pdf;
     }
@@ -45,10 +45,16 @@ struct VertexGuide {
 VertexGuide guide_at(SDTree *tree, bool learn, const SurfaceInteraction &si, float bsdf_fraction);
 
 // The next direction by one-sample MIS: u_choice picks the strategy, (u1, u2) drive it. The sample's pdf
-// is the mixture's and its weight f·|cos| / pdf. A direction drawn from the tree carries eta 1 (its only
-// reader is Russian roulette, which any value keeps unbiased).
+// is the mixture's and its weight f·|cos| / pdf; bsdf_pdf receives the BSDF's own density of it. A
+// direction drawn from the tree carries eta 1 (its only reader is Russian roulette, which any value keeps
+// unbiased).
+//
+// MIS against next event estimation weighs the BSDF strategy by the BSDF's own density, not the
+// mixture's: power-heuristic weights formed from any densities that are zero only where the strategies'
+// are still sum to one, so the estimate stays unbiased, and the guide's density is then not asked for
+// NEE's weight (two of the up to six quadtree lookups of a vertex where the surface folds the guide).
 BSDFSample sample_guided(const VertexGuide &g, const BSDF &bsdf, const SurfaceInteraction &si, float u_choice, float u1,
-                         Vec2 u2);
+                         Vec2 u2, float &bsdf_pdf);
 
 // The guided vertices of one path, each with what the path had gathered and its throughput when the
 // vertex's direction was chosen: what the path gathers later, divided by that throughput, is the radiance
