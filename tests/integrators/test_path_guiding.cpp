@@ -99,6 +99,10 @@ TEST(PathGuiding, UnbiasedAgainstPlainNee) {
         const std::string path = write_temp_scene(xml);
         const BlockMoments nee = block_moments(path, "path", Options(), 6, 64, 101);
         expect_same_image(nee, guided_moments(path, kGuided, 6, 64, 202, nullptr), name + " guided");
+        // Mostly the learned guide (a tenth of the directions by the BSDF).
+        OptionMap mostly_guide = kGuided;
+        mostly_guide["guiding_bsdf_fraction"] = "0.1";
+        expect_same_image(nee, guided_moments(path, mostly_guide, 6, 64, 252, nullptr), name + " guided, bsdf_fraction 0.1");
         OptionMap bsdf_only = kGuided;
         bsdf_only["nee"] = "false";
         expect_same_image(nee, guided_moments(path, bsdf_only, 6, 64, 303, nullptr), name + " guided, nee=false");
