@@ -107,6 +107,8 @@ const std::vector<OptionMap> kOptionSets = {
     {{"ris", "4"}},
     {{"ris", "4"}, {"ris_depth", "-1"}},
     {{"ris", "8"}, {"ris_depth", "3"}, {"shadow_rays", "neepp"}, {"light_sampler", "power"}},
+    {{"guiding", "sdtree"}},
+    {{"guiding", "sdtree"}, {"ris", "4"}, {"shadow_rays", "neepp"}},
 };
 
 std::string describe(const Family &f, const OptionMap &o) {
@@ -234,6 +236,7 @@ TEST(PathForms, SameImageInExpectation) {
         {3, {{"shadow_rays", "neepp"}}}, {4, {{"shadow_rays", "neepp-adaptive"}}},
         {5, {{"within_light", "visibility"}}}, {5, {{"max_depth", "-1"}, {"rr_depth", "1"}}},
         {6, {{"area_light_sampling", "solid-angle"}}}, {0, {{"area_light_sampling", "solid-angle"}}},
+        {0, {{"guiding", "sdtree"}}}, {5, {{"guiding", "sdtree"}, {"guiding_bsdf_fraction", "0.3"}, {"guiding_learn_direct", "false"}}},
     };
     for (auto [family, o] : cases) {
         const std::string what = describe(kFamilies[family], o);

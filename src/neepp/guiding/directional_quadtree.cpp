@@ -77,29 +77,32 @@ int DirectionalQuadtree::depth() const {
     return deepest;
 }
 
+// The product of the shares 4·sum[q] / total along the descent telescopes (a child's total is its
+// quadrant's sum in the parent, set_leaf_sums), so the density is 4^depth · leaf sum / root total: one
+// division, where the product took one per level (the guide's pdf is asked up to four times a vertex);
+// sample() forms its density the same way.
 double DirectionalQuadtree::pdf(double u, double v) const {
-    double pdf = 1.0;
+    const double total = quadrant_total(nodes_[0]);
+    if (!(total > 0)) return 0.0;
     uint32_t node = 0;
-    for (;;) {
+    int depth = 1;
+    for (;; ++depth) {
         const Node &n = nodes_[node];
-        const double total = quadrant_total(n);
         const int ix = u >= 0.5, iy = v >= 0.5;
         const int q = ix | (iy << 1);
-        if (!(total > 0) || !(n.sum[q] > 0)) return 0.0;
-        pdf *= 4.0 * n.sum[q] / total;
         u = 2.0 * u - ix;
         v = 2.0 * v - iy;
-        if (!n.child[q]) return pdf;
+        if (!n.child[q]) return n.sum[q] > 0 ? std::ldexp(n.sum[q] / total, 2 * depth) : 0.0;
         node = n.child[q];
     }
 }
 
 DirectionalQuadtree::Sample DirectionalQuadtree::sample(double u0, double u1) const {
     Sample s;
-    s.pdf = 1.0;
+    const double root_total = quadrant_total(nodes_[0]);
     double x0 = 0, y0 = 0, size = 1;  // the current node's cell
     uint32_t node = 0;
-    for (;;) {
+    for (int depth = 1;; ++depth) {
         const Node &n = nodes_[node];
         const double total = quadrant_total(n);
         // x half by the energy of its two quadrants, then y half within it.
@@ -108,11 +111,11 @@ DirectionalQuadtree::Sample DirectionalQuadtree::sample(double u0, double u1) co
         u0 = below_one(u0);
         u1 = below_one(u1);
         const int q = ix | (iy << 1);
-        s.pdf *= 4.0 * n.sum[q] / total;
         size *= 0.5;
         x0 += ix * size;
         y0 += iy * size;
         if (!n.child[q]) {
+            s.pdf = std::ldexp(n.sum[q] / root_total, 2 * depth);  // as pdf() forms it, to the bit
             // Uniform in the leaf's cell; kept inside it, so that pdf() of the point descends here too.
             s.u = std::min(x0 + u0 * size, std::nextafter(x0 + size, 0.0));
             s.v = std::min(y0 + u1 * size, std::nextafter(y0 + size, 0.0));

@@ -2,7 +2,8 @@
 // the unit square, which the cylindrical mapping (cos θ, φ) takes onto the sphere with a constant Jacobian
 // (dω = 4π du dv), so a density piecewise constant on the square is piecewise constant in solid angle.
 // Each node holds the energy of its four quadrants; sampling descends by those energies, and the density
-// of a point is the product of the quadrant shares along the same descent, so the two agree exactly.
+// of a point is the product of the quadrant shares along the same descent: 4^depth times its leaf's share
+// of the total, to which the product telescopes, formed alike by both, so the two agree to the bit.
 // Doubles throughout: a leaf at depth 20 is 2^-21 wide, and the product of 20 shares must not drift.
 #pragma once
 #include <array>

@@ -118,6 +118,13 @@ std::unique_ptr<PathIntegrator> make_path(const Options &options, bool volumetri
         if (guiding != "none" && guiding != "sdtree")
             throw std::invalid_argument("guiding must be 'none' or 'sdtree', not '" + guiding + "'");
         o.guiding = guiding == "sdtree";
+        o.guiding_bsdf_fraction = options.get_float("guiding_bsdf_fraction", o.guiding_bsdf_fraction);
+        if (!(o.guiding_bsdf_fraction > 0.f && o.guiding_bsdf_fraction <= 1.f))
+            throw std::invalid_argument("guiding_bsdf_fraction must be in (0, 1]: the BSDF's share keeps guiding unbiased");
+        o.guiding_spatial_threshold = double(options.get_float("guiding_spatial_threshold", float(o.guiding_spatial_threshold)));
+        o.guiding_learn_direct = options.get_bool("guiding_learn_direct", o.guiding_learn_direct);
+        if (!(o.guiding_spatial_threshold >= 0))
+            throw std::invalid_argument("guiding_spatial_threshold must be >= 0 (0: scaled to the image)");
     } else if (options.has("guiding")) {
         throw std::invalid_argument("volpath: guiding is refused: it is the path integrator's (path -I guiding=sdtree)");
     }

@@ -60,9 +60,17 @@ std::vector<IntegratorDoc> make_docs() {
                             "definition: the same image in expectation, slower)", ""});
     path.options.push_back({"guiding", "none",
                             "none, or sdtree: practical path guiding (Mueller et al. 2017), an SD-tree learned from "
-                            "each pass's paths guides the next direction by one-sample MIS with the BSDF (half each) "
-                            "where the BSDF has no delta part; unbiased whatever it learned; renders with the "
-                            "reference form", ""});
+                            "each pass's paths guides the next direction by one-sample MIS with the BSDF "
+                            "where the BSDF has no delta part; unbiased whatever it learned", ""});
+    path.options.push_back({"guiding_bsdf_fraction", text(p.guiding_bsdf_fraction),
+                            "guiding=sdtree: the share of next directions the BSDF samples (the rest the guide), "
+                            "in (0, 1]", ""});
+    path.options.push_back({"guiding_spatial_threshold", text(float(p.guiding_spatial_threshold)),
+                            "guiding=sdtree: c, a spatial leaf of the SD-tree splits past c * sqrt(pass spp) "
+                            "records (0: PPG's 12000 scaled by sqrt(pixels / 1280x720))", ""});
+    path.options.push_back({"guiding_learn_direct", text(p.guiding_learn_direct),
+                            "guiding=sdtree: the guide learns the emission a guided direction finds directly too "
+                            "(false: only the light next event estimation does not bring)", ""});
     path.options.push_back({"nee", text(p.nee), "next event estimation (false: BSDF sampling only, the paper's Path)", ""});
     path.options.push_back({"light_sampler", p.light_sampler, "which light NEE samples: " + samplers, ""});
     path.options.push_back({"within_light", p.within_light,
@@ -90,7 +98,7 @@ std::vector<IntegratorDoc> make_docs() {
     volpath.description = "volumetric path tracing through participating media (Mitsuba 3's volpath): null surfaces "
                           "crossed without a bounce, shadow rays through media and null surfaces; the reference form "
                           "only";
-    std::erase_if(volpath.options, [](const OptionDoc &o) { return o.name == "form" || o.name == "guiding" || o.name.rfind("ris", 0) == 0;
+    std::erase_if(volpath.options, [](const OptionDoc &o) { return o.name == "form" || o.name.rfind("guiding", 0) == 0 || o.name.rfind("ris", 0) == 0;
     });
     docs.push_back(volpath);
 

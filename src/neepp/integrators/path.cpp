@@ -24,7 +24,7 @@ PathIntegrator::PathIntegrator(PathOptions options, std::unique_ptr<ShadowRayTes
 PathIntegrator::~PathIntegrator() = default;
 
 const RayBatch *PathIntegrator::batch() const {
-    return options_.reference || options_.volumetric || options_.guiding ? nullptr : batch_.get();
+    return options_.reference || options_.volumetric ? nullptr : batch_.get();
 }
 
 void PathIntegrator::prepare(const Scene &scene) {
@@ -46,7 +46,16 @@ void PathIntegrator::prepare(const Scene &scene) {
     within_light_ = WithinLightSampling(options_.within_light, scene, shadow_->voxel_grid(), shadow_->visibility_map(),
                                         options_.area_light_sampling);
     refresh_resampling();
-    if (options_.guiding && guide_learns_) guide_ = std::make_unique<SDTree>(scene.bounds());
+    if (options_.guiding && guide_learns_) {
+        SDTreeOptions tree;
+        // PPG's c = 12000 is for 1280x720 images: a leaf splits past c·√(pass spp) records, and the
+        // records of a pass grow with the pixels, so at the same c a smaller image gets fewer leaves.
+        // 0 scales c by √(pixels / 1280·720), which keeps the leaves' count at PPG's √(records) rate.
+        const double pixels = double(scene.camera.width) * double(scene.camera.height);
+        tree.spatial_threshold = options_.guiding_spatial_threshold > 0 ? options_.guiding_spatial_threshold
+                                                                        : 12000.0 * std::sqrt(pixels / (1280.0 * 720.0));
+        guide_ = std::make_unique<SDTree>(scene.bounds(), tree);
+    }
     guide_spp_ = 0;
 }
 
@@ -107,7 +116,7 @@ nlohmann::json PathIntegrator::describe() const {
             {"ris", options_.ris},
             {"ris_floor", options_.ris_floor},
             {"ris_depth", options_.ris_depth},
-            {"form", options_.reference || options_.guiding ? "reference" : "fast"},
+            {"form", options_.reference || options_.volumetric ? "reference" : "fast"},
             {"guiding", options_.guiding ? "sdtree" : "none"},
             {"shadow_rays", shadow_->policy()},
             {"shadow_ray_options", shadow_->describe()}};
@@ -138,8 +147,7 @@ struct PathIntegrator::LightCandidate {
 };
 
 Color PathIntegrator::sample_direct(const Scene &scene, const SurfaceInteraction &si, const LightSampleContext &ctx,
-                                    const Color &beta, int M, Sampler &sampler, RenderCounters &counters,
-                                    const VertexGuide &guide) const {
+                                    const Color &beta, int M, Sampler &sampler, RenderCounters &counters) const {
     const BSDF &bsdf = *si.shape->bsdf;
     // M candidates, each a light chosen by the light sampler and a point on it, by the light's own sampling
     // or within_light's. Without resampling (M = 1) the one candidate is the sample.
@@ -190,7 +198,7 @@ Color PathIntegrator::sample_direct(const Scene &scene, const SurfaceInteraction
     }
     // MIS against BSDF sampling, by the light strategy's source density (see emission_weight).
     const float light_pdf = y.ds.pdf * y.light.pmf;
-    const float w_mis = y.ds.delta ? 1.f : mis_power(light_pdf, guide.pdf(y.ds.d, bsdf_pdf));
+    const float w_mis = y.ds.delta ? 1.f : mis_power(light_pdf, bsdf_pdf);
     // The shadow-ray component decides whether to trace (NEE++: with probability q, weight 1/q) and traces.
     ShadowQuery q;
     q.ray = y.ds.dist >= kInfinity ? si.spawn_ray(y.ds.d) : si.spawn_ray_to(y.ds.p);
@@ -219,6 +227,7 @@ Color PathIntegrator::Li(const Scene &scene, const Ray &camera_ray, Sampler &sam
     float prev_bsdf_pdf = 1.f;
     bool prev_delta = true;  // the camera counts as a delta vertex: no MIS on directly seen lights
     GuideRecorder recorder;  // guiding=sdtree: what the path tells the guide
+    const bool learn_direct = options_.guiding_learn_direct;
     for (int depth = 0;; ++depth) {
         SurfaceInteraction si;
         const bool hit = scene.intersect(ray, si);
@@ -234,6 +243,7 @@ Color PathIntegrator::Li(const Scene &scene, const Ray &camera_ray, Sampler &sam
                     const float w = prev_delta ? 1.f
                                                : emission_weight(*env, prev, direction_sample_from_miss(ray.d), prev_bsdf_pdf);
                     L += beta * Le * w;
+                    if (!learn_direct) recorder.found_emission(depth - 1, beta * Le * w);
                 }
             break;
         }
@@ -243,6 +253,7 @@ Color PathIntegrator::Li(const Scene &scene, const Ray &camera_ray, Sampler &sam
                 const float w = prev_delta ? 1.f
                                            : emission_weight(*area, prev, direction_sample_from_hit(prev.p, si), prev_bsdf_pdf);
                 L += beta * Le * w;
+                if (!learn_direct) recorder.found_emission(depth - 1, beta * Le * w);
             }
         }
         // max_depth counts vertices: the next one's emission would be one too many.
@@ -250,28 +261,29 @@ Color PathIntegrator::Li(const Scene &scene, const Ray &camera_ray, Sampler &sam
 
         // Next event estimation, where the BSDF has a smooth part a light sample can reach.
         const LightSampleContext ctx = light_context(si, ray.d);
-        const VertexGuide guide = guide_at(guide_.get(), guide_learns_, si, PathOptions::kGuidingBsdfFraction);
+        const VertexGuide guide = guide_at(guide_.get(), guide_learns_, si, options_.guiding_bsdf_fraction);
         if (options_.nee && (si.shape->bsdf_flags & BSDFSmooth))
-            L += sample_direct(scene, si, ctx, beta, candidates_at(depth), sampler, counters, guide);
+            L += sample_direct(scene, si, ctx, beta, candidates_at(depth), sampler, counters);
 
         // The next direction: by the BSDF, or where a guide has learned, by the BSDF or the guide.
         const BSDF &bsdf = *si.shape->bsdf;
         const float u_choice = guide.tree ? sampler.next_1d() : 0.f;
         const float u1 = sampler.next_1d();
         const Vec2 u2 = sampler.next_2d();
-        const BSDFSample bs = guide.tree ? sample_guided(guide, bsdf, si, u_choice, u1, u2)
+        float own_pdf = 0.f;  // the BSDF's density of a guided sample, for MIS (sample_guided)
+        const BSDFSample bs = guide.tree ? sample_guided(guide, bsdf, si, u_choice, u1, u2, own_pdf)
                                          : bsdf.sample(BSDFContext{}, si, si.wi, u1, u2);
         if (!bs.valid()) break;
         beta *= bs.weight;
         eta *= bs.eta;
         prev = ctx;
-        prev_bsdf_pdf = bs.pdf;
+        prev_bsdf_pdf = guide.tree ? own_pdf : bs.pdf;
         prev_delta = (bs.sampled_flags & BSDFDelta) != 0;
         ray = si.spawn_ray(si.to_world(bs.wo));
 
         if (depth + 1 >= options_.rr_depth && !survives_roulette(beta, eta, sampler)) break;
         if (!(max_component(beta) > 0)) break;
-        if (guide.record) recorder.add(si.p, ray.d, bs.pdf, beta, L);
+        if (guide.record) recorder.add(depth, si.p, ray.d, bs.pdf, beta, L);
     }
     if (guide_ && guide_learns_) recorder.commit(*guide_, L);
     return L;

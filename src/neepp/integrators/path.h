@@ -39,10 +39,18 @@ struct PathOptions {
     // and shadow rays that pass such surfaces and media with their transmittance. Reference form only.
     bool volumetric = false;
     // Practical path guiding (guiding=sdtree, path_guiding.h): at vertices without a delta BSDF part the
-    // next direction is drawn by one-sample MIS between the BSDF (this share) and an SD-tree learned from
-    // the passes before; NEE stays for direct light. Rendered by the reference form.
+    // next direction is drawn by one-sample MIS between the BSDF (guiding_bsdf_fraction of the samples) and
+    // an SD-tree learned from the passes before; NEE stays for direct light. Both forms render it.
     bool guiding = false;
-    static constexpr float kGuidingBsdfFraction = 0.5f;  // PPG's
+    // PPG's is 0.5; with NEE on classroom and living-room (docs/performance.md) 0.75 measured less noisy
+    // (relVar 0.94x NEE's against 0.98-1.08x) and 0.9 no less noisy than 0.75.
+    float guiding_bsdf_fraction = 0.75f;
+    // The SD-tree's spatial threshold c (SDTreeOptions::spatial_threshold); 0: scaled to the image
+    // (sd_tree.h).
+    double guiding_spatial_threshold = 12000;
+    // What a guided vertex's record holds: all the radiance its direction brought (true), or that less the
+    // emission the direction found directly (false: the light next event estimation also samples).
+    bool guiding_learn_direct = true;
 };
 
 class PathBatch;
@@ -100,10 +108,9 @@ private:
     // Next event estimation at a scattering vertex (pbrt-v4's SampleLd): a light sample, or with ris > 1
     // one of M resampled ones, tested by the shadow-ray component; the contribution already multiplied by
     // the path throughput beta, which contribution-aware shadow-ray policies need to see.
-    // With a guide, the BSDF strategy's density in the MIS weight is the guided mixture's.
+    // With a guide, the BSDF strategy's density in the MIS weight is still the BSDF's own (sample_guided).
     Color sample_direct(const Scene &scene, const SurfaceInteraction &si, const LightSampleContext &ctx,
-                        const Color &beta, int M, Sampler &sampler, RenderCounters &counters,
-                        const VertexGuide &guide) const;
+                        const Color &beta, int M, Sampler &sampler, RenderCounters &counters) const;
     // MIS weight for emission found by a BSDF-sampled ray leaving prev (pdf prev_pdf) toward light.
     float emission_weight(const Light &light, const LightSampleContext &prev, const DirectionSample &ds,
                           float prev_pdf) const;

@@ -10,6 +10,7 @@
 #include "neepp/base/bsdf.h"
 #include "neepp/base/light_selection_learner.h"
 #include "neepp/base/light_steps.h"
+#include "neepp/integrators/path_guiding.h"
 #include "neepp/lights/light_lanes.h"
 #include "neepp/math/warp.h"
 #include "neepp/sampling/sampler.h"
@@ -55,6 +56,10 @@ struct PathBatch::Path {
     // Next event estimation's shadow query, while its ray waits to be traced with the batch's others.
     ShadowQuery shadow;
     ShadowTest test;
+    // guiding=sdtree: the vertex's guide (no tree: the BSDF samples alone), and what the path tells the
+    // guide when it ends (null: it learns nothing).
+    VertexGuide guide;
+    GuideRecorder *recorder = nullptr;
 
     // A new camera path in this slot. Only the state read before it is written is reset: the vertex,
     // light and shadow-query fields are written at each bounce before any read (and the texture memo in si
@@ -68,6 +73,7 @@ struct PathBatch::Path {
         depth = 0;
         prev_bsdf_pdf = 1.f;
         prev_delta = true;
+        if (recorder) recorder->clear();
     }
 };
 
@@ -84,6 +90,8 @@ bool PathBatch::begin_vertex(const Scene &scene, Path &path) const {
                                           : pi.emission_weight(*env, path.prev, direction_sample_from_miss(ray.d),
                                                             path.prev_bsdf_pdf);
                 path.L += path.beta * Le * w;
+                if (path.recorder && !pi.options_.guiding_learn_direct)
+                    path.recorder->found_emission(path.depth - 1, path.beta * Le * w);
             }
         return false;
     }
@@ -95,6 +103,8 @@ bool PathBatch::begin_vertex(const Scene &scene, Path &path) const {
                                       : pi.emission_weight(*area, path.prev, direction_sample_from_hit(path.prev.p, si),
                                                         path.prev_bsdf_pdf);
             path.L += path.beta * Le * w;
+            if (path.recorder && !pi.options_.guiding_learn_direct)
+                path.recorder->found_emission(path.depth - 1, path.beta * Le * w);
         }
     }
     if (pi.options_.max_depth >= 0 && path.depth + 1 >= pi.options_.max_depth) return false;
@@ -102,6 +112,7 @@ bool PathBatch::begin_vertex(const Scene &scene, Path &path) const {
     const BSDF &bsdf = *si.shape->bsdf;
     bsdf.prefetch(si);
     path.ctx = PathIntegrator::light_context(si, ray.d);
+    path.guide = guide_at(pi.guide_.get(), pi.guide_learns_, si, pi.options_.guiding_bsdf_fraction);
     path.nee = pi.options_.nee && (si.shape->bsdf_flags & BSDFSmooth);
     path.m = pi.candidates_at(path.depth);
     if (!path.nee) return true;
@@ -233,7 +244,8 @@ bool PathBatch::begin_direct(Path &path) const {
     }
     if (learner) path.learn = luminance(f * Le) / ds.pdf;
     float light_pdf = ds.pdf * sl.pmf;
-    float w = ds.delta ? 1.f : mis_power(light_pdf, bsdf_pdf);  // see emission_weight
+    // See emission_weight; with a guide too, the BSDF strategy's density is the BSDF's own (sample_guided).
+    float w = ds.delta ? 1.f : mis_power(light_pdf, bsdf_pdf);
     ShadowQuery &q = path.shadow = ShadowQuery{};  // nothing the policy kept from the last bounce
     q.ray = ds.dist >= kInfinity ? si.spawn_ray(ds.d) : si.spawn_ray_to(ds.p);
     q.from = si.p;
@@ -274,14 +286,18 @@ bool PathBatch::finish_vertex(Path &path) const {
     const SurfaceInteraction &si = path.si;
     const BSDF &bsdf = *si.shape->bsdf;
     Sampler &sampler = *path.sampler;
+    const VertexGuide &guide = path.guide;
+    const float u_choice = guide.tree ? sampler.next_1d() : 0.f;  // in Li's order
     float u1 = sampler.next_1d();
     Vec2 u2 = sampler.next_2d();
-    BSDFSample bs = bsdf.sample(BSDFContext{}, si, si.wi, u1, u2);
+    float own_pdf = 0.f;  // the BSDF's density of a guided sample, for MIS (sample_guided)
+    BSDFSample bs = guide.tree ? sample_guided(guide, bsdf, si, u_choice, u1, u2, own_pdf)
+                               : bsdf.sample(BSDFContext{}, si, si.wi, u1, u2);
     if (!bs.valid()) return false;
     path.beta *= bs.weight;
     path.eta *= bs.eta;
     path.prev = path.ctx;
-    path.prev_bsdf_pdf = bs.pdf;
+    path.prev_bsdf_pdf = guide.tree ? own_pdf : bs.pdf;
     path.prev_delta = (bs.sampled_flags & BSDFDelta) != 0;
     path.ray = si.spawn_ray(si.to_world(bs.wo));
     ++path.depth;
@@ -292,7 +308,9 @@ bool PathBatch::finish_vertex(Path &path) const {
         if (!(sampler.next_1d() < q)) return false;
         path.beta /= q;
     }
-    return max_component(path.beta) > 0;
+    if (!(max_component(path.beta) > 0)) return false;
+    if (guide.record && path.recorder) path.recorder->add(path.depth - 1, si.p, path.ray.d, bs.pdf, path.beta, path.L);
+    return true;
 }
 
 void PathBatch::Li_batch(const Scene &scene, std::span<const Ray> rays, std::span<Sampler *const> samplers,
@@ -306,15 +324,19 @@ void PathBatch::Li_batch(const Scene &scene, std::span<const Ray> rays, std::spa
         std::array<Path, kBatch> paths;
         std::array<uint32_t, kBatch> active, pending;
         std::vector<Candidate> candidates;  // each path's options.ris, one after another
+        std::vector<GuideRecorder> recorders;  // guiding=sdtree while the guide learns: one per path
     };
     thread_local std::unique_ptr<Slots> slots;
     if (!slots) slots = std::make_unique<Slots>();
-    auto &[paths, active, pending, candidates] = *slots;
+    auto &[paths, active, pending, candidates, recorders] = *slots;
     const size_t M = size_t(pi.options_.ris);
     if (candidates.size() < kBatch * M) candidates.resize(kBatch * M);
+    SDTree *const learning = pi.guide_learns_ ? pi.guide_.get() : nullptr;
+    if (learning && recorders.size() < kBatch) recorders.resize(kBatch);
     for (size_t base = 0; base < rays.size(); base += kBatch) {
         const size_t n = std::min(kBatch, rays.size() - base);
         for (size_t i = 0; i < n; ++i) {
+            paths[i].recorder = learning ? &recorders[i] : nullptr;
             paths[i].start(rays[base + i], samplers[base + i]);
             paths[i].candidates = &candidates[i * M];
             active[i] = uint32_t(i);
@@ -372,6 +394,8 @@ void PathBatch::Li_batch(const Scene &scene, std::span<const Ray> rays, std::spa
                 if (finish_vertex(paths[active[k]])) active[live++] = active[k];
         }
         for (size_t i = 0; i < n; ++i) out[base + i] = paths[i].L;
+        if (learning)
+            for (size_t i = 0; i < n; ++i) recorders[i].commit(*learning, paths[i].L);
     }
 }
 

@@ -21,10 +21,11 @@ VertexGuide guide_at(SDTree *tree, bool learn, const SurfaceInteraction &si, flo
 }
 
 BSDFSample sample_guided(const VertexGuide &g, const BSDF &bsdf, const SurfaceInteraction &si, float u_choice, float u1,
-                         Vec2 u2) {
+                         Vec2 u2, float &bsdf_pdf) {
     if (u_choice < g.bsdf_fraction) {
         BSDFSample bs = bsdf.sample(BSDFContext{}, si, si.wi, u1, u2);
         if (!bs.valid()) return bs;
+        bsdf_pdf = bs.pdf;
         const float pdf = g.pdf(si.to_world(bs.wo), bs.pdf);
         bs.weight *= bs.pdf / pdf;  // f·|cos| / mixture pdf
         bs.pdf = pdf;
@@ -37,6 +38,7 @@ BSDFSample sample_guided(const VertexGuide &g, const BSDF &bsdf, const SurfaceIn
     // The tree's density of d as pdf() gives it, which is the one the BSDF-sampled branch sees too.
     const float pdf = g.pdf(d, e.pdf);
     if (!(pdf > 0) || is_black(e.f)) return BSDFSample{};
+    bsdf_pdf = e.pdf;
     bs.pdf = pdf;
     bs.weight = e.f / pdf;
     bs.sampled_flags = bs.wo.z * si.wi.z > 0 ? BSDFGlossyReflection : BSDFGlossyTransmission;
@@ -49,7 +51,7 @@ void GuideRecorder::commit(SDTree &tree, const Color &L) const {
         // Per channel, where the throughput lets the channel through; the tree keeps their mean.
         double arrived = 0;
         for (int c = 0; c < 3; ++c)
-            if (v.beta[c] > 0) arrived += double(L[c] - v.L[c]) / double(v.beta[c]);
+            if (v.beta[c] > 0) arrived += double(L[c] - v.L[c] - v.direct[c]) / double(v.beta[c]);
         tree.record(v.p, v.d, std::max(arrived, 0.0) / 3.0 / double(v.pdf));
     }
 }

@@ -35,7 +35,7 @@ struct VertexGuide {
         return fold && dot(d, up) < 0 ? mirror(d, up) : d;
     }
     // The density with which the vertex samples world direction d, the BSDF's own density being bsdf_pdf:
-    // what weighs the sample, and what MIS against next event estimation must see as the BSDF strategy's.
+    // what weighs the sample.
     float pdf(const Vec3 &d, float bsdf_pdf) const {
         return tree ? bsdf_fraction * bsdf_pdf + (1.f - bsdf_fraction) * guide_pdf(d) : bsdf_pdf;
     }
@@ -45,27 +45,42 @@ struct VertexGuide {
 VertexGuide guide_at(SDTree *tree, bool learn, const SurfaceInteraction &si, float bsdf_fraction);
 
 // The next direction by one-sample MIS: u_choice picks the strategy, (u1, u2) drive it. The sample's pdf
-// is the mixture's and its weight f·|cos| / pdf. A direction drawn from the tree carries eta 1 (its only
-// reader is Russian roulette, which any value keeps unbiased).
+// is the mixture's and its weight f·|cos| / pdf; bsdf_pdf receives the BSDF's own density of it. A
+// direction drawn from the tree carries eta 1 (its only reader is Russian roulette, which any value keeps
+// unbiased).
+//
+// MIS against next event estimation weighs the BSDF strategy by the BSDF's own density, not the
+// mixture's: power-heuristic weights formed from any densities that are zero only where the strategies'
+// are still sum to one, so the estimate stays unbiased, and the guide's density is then not asked for
+// NEE's weight (two of the up to six quadtree lookups of a vertex where the surface folds the guide).
 BSDFSample sample_guided(const VertexGuide &g, const BSDF &bsdf, const SurfaceInteraction &si, float u_choice, float u1,
-                         Vec2 u2);
+                         Vec2 u2, float &bsdf_pdf);
 
 // The guided vertices of one path, each with what the path had gathered and its throughput when the
 // vertex's direction was chosen: what the path gathers later, divided by that throughput, is the radiance
 // that arrived along the direction, and that over the direction's density is PPG's record.
 class GuideRecorder {
 public:
-    void add(const Vec3 &p, const Vec3 &d, float pdf, const Color &beta, const Color &L) {
-        if (n_ < int(v_.size())) v_[n_++] = {p, d, pdf, beta, L};
+    // The vertex at path depth `depth` (the camera's first hit is 0).
+    void add(int depth, const Vec3 &p, const Vec3 &d, float pdf, const Color &beta, const Color &L) {
+        if (n_ < int(v_.size())) v_[n_++] = {p, d, pdf, beta, L, Color(0.f), depth};
+    }
+    // Emission that the direction chosen at depth `depth` found directly, as the path gathered it (its
+    // MIS weight included): left out of that vertex's record when the guide learns only the light that
+    // next event estimation does not bring (PathOptions::guiding_learn_direct false).
+    void found_emission(int depth, const Color &contribution) {
+        if (n_ > 0 && v_[n_ - 1].depth == depth) v_[n_ - 1].direct += contribution;
     }
     // Records every vertex into the tree, L being all the path gathered.
     void commit(SDTree &tree, const Color &L) const;
+    void clear() { n_ = 0; }
 
 private:
     struct Vertex {
         Vec3 p, d;
         float pdf;
-        Color beta, L;
+        Color beta, L, direct;
+        int depth;
     };
     std::array<Vertex, 64> v_;  // longer paths record their first 64 vertices
     int n_ = 0;
