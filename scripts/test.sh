@@ -47,7 +47,7 @@ stage tsan "$ROOT/scripts/test_tsan.sh"
 stage fuzz "$ROOT/scripts/fuzz.sh" 10
 cd "$ROOT"
 # Two workers (pytest-xdist): much of a test's time leaves a core idle (Mitsuba's JIT, loading, a process
-# starting, a server waited on). Each module runs in one worker (tests/python/conftest.py).
+# starting, a server waited on). Each module runs in one worker (--dist loadfile: tests/python/conftest.py).
 NEEPP_BIN="$ROOT/build/neepp" stage pytest "$ROOT/.venv/bin/python" -m pytest tests/python -q -rs --durations=30 \
-  -n 2 --dist loadgroup
+  -n 2 --dist loadfile
 printf 'test.sh: %s\n' "${TIMES[@]}"

@@ -109,6 +109,8 @@ const std::vector<OptionMap> kOptionSets = {
     {{"ris", "8"}, {"ris_depth", "3"}, {"shadow_rays", "neepp"}, {"light_sampler", "power"}},
     {{"guiding", "sdtree"}},
     {{"guiding", "sdtree"}, {"ris", "4"}, {"shadow_rays", "neepp"}},
+    {{"guiding", "map"}},
+    {{"guiding", "map"}, {"ris", "4"}, {"shadow_rays", "neepp"}},
 };
 
 std::string describe(const Family &f, const OptionMap &o) {
@@ -237,6 +239,7 @@ TEST(PathForms, SameImageInExpectation) {
         {5, {{"within_light", "visibility"}}}, {5, {{"max_depth", "-1"}, {"rr_depth", "1"}}},
         {6, {{"area_light_sampling", "solid-angle"}}}, {0, {{"area_light_sampling", "solid-angle"}}},
         {0, {{"guiding", "sdtree"}}}, {5, {{"guiding", "sdtree"}, {"guiding_bsdf_fraction", "0.3"}, {"guiding_learn_direct", "false"}}},
+        {0, {{"guiding", "map"}}}, {5, {{"guiding", "map"}, {"guiding_bsdf_fraction", "0.3"}, {"guiding_learn_direct", "false"}}},
     };
     for (auto [family, o] : cases) {
         const std::string what = describe(kFamilies[family], o);

@@ -1,4 +1,4 @@
-// Practical path guiding in the path integrator (guiding=sdtree): the guided image against plain NEE's
+// Path guiding in the path integrator (guiding=sdtree and guiding=map): the guided image against plain NEE's
 // (per-block z-tests), with the guide learning as it renders and with guides that are deliberately wrong
 // for the scene, which must cost variance only; images the same to the bit for a seed and thread count;
 // the option accepted where it is implemented and refused elsewhere.
@@ -78,12 +78,20 @@ TEST(PathGuiding, GuideLearnsFromThePasses) {
 
 // Block moments of the guided integrator; `guide` (when given) is installed before each render and kept.
 BlockMoments guided_moments(const std::string &path, const OptionMap &o, int seeds, int spp, uint64_t seed0,
-                            const SDTree *guide) {
+                            const SDTree *guide, const std::string *map_guide = nullptr) {
     std::vector<std::vector<double>> per_seed;
     for (int s = 0; s < seeds; ++s) {
         auto scene = load_scene(path);
         auto integrator = make_integrator("path", with_scene_options(*scene, Options(o)));
-        if (guide) dynamic_cast<PathIntegrator &>(*integrator).install_guide(std::make_unique<SDTree>(*guide));
+        auto &pi = dynamic_cast<PathIntegrator &>(*integrator);
+        if (guide) pi.install_guide(std::make_unique<SDTree>(*guide));
+        if (map_guide) {  // saved totals, on the grid this integrator's map will have
+            pi.prepare(*scene);
+            auto m = std::make_unique<MapGuide>(*pi.shadow_rays().voxel_grid());
+            m->load(*map_guide);
+            m->update(nullptr);
+            pi.install_map_guide(std::move(m));
+        }
         RenderJob job;
         job.spp = spp;
         job.seed = seed0 + 31 * s;
@@ -235,7 +243,7 @@ TEST(PathGuiding, ChiSquareOfTheVertexGuideAgainstItsDensity) {
         std::vector<double> observed(size_t(n) * n, 0.0), expected(size_t(n) * n, 0.0);
         PCG32 r(2, 2);
         for (int i = 0; i < samples; ++i) {
-            const Vec3 d = g.sample(r.next_2d());
+            const Vec3 d = g.sample(0.f, 0.f, r.next_2d());
             if (fold) ASSERT_GE(d.z, 0.f);
             const double c = std::clamp((double(d.z) + 1) / 2, 0.0, std::nextafter(1.0, 0.0));
             double phi = std::atan2(double(d.y), double(d.x));
@@ -259,6 +267,128 @@ TEST(PathGuiding, ChiSquareOfTheVertexGuideAgainstItsDensity) {
         EXPECT_TRUE(res.error.empty()) << res.error;
         EXPECT_GT(res.p_value, 0.01 / 2) << fold << " " << res.describe();
     }
+}
+
+
+// The visibility map's guide (guiding=map): learned as the render goes, mostly sampled, without NEE, and
+// deliberately wrong, the image is plain NEE's; the same to the bit for a seed and thread count; the state
+// carries its totals and merges what several renders added.
+const OptionMap kMapGuided = {{"guiding", "map"}};
+
+TEST(MapGuiding, OptionKeepsAMapAndLearns) {
+    auto scene = load_scene(write_temp_scene(lit_room_xml()));
+    auto integrator = make_integrator("path", with_scene_options(*scene, Options(kMapGuided)));
+    EXPECT_EQ(integrator->describe()["guiding"], "map");
+    RenderJob job;
+    job.spp = 16;
+    job.seed = 3;
+    render(*scene, *integrator, job);
+    const auto &pi = dynamic_cast<const PathIntegrator &>(*integrator);
+    ASSERT_NE(pi.shadow_rays().visibility_map(), nullptr) << "the guide's prior reads the map";
+    const MapGuide *guide = pi.map_guide();
+    ASSERT_NE(guide, nullptr);
+    EXPECT_GT(guide->records(), 1000u);
+    EXPECT_GT(guide->table_count(), 10u);
+    EXPECT_NE(guide->table_at(Vec3(0.f, 0.05f, 0.f)), nullptr) << "the floor under the camera";
+    EXPECT_EQ(integrator->statistics()["guiding"]["kind"], "map");
+    EXPECT_THROW(make_integrator("path", Options(OptionMap{{"guiding", "map"}, {"neepp", "auto"}})), std::invalid_argument);
+}
+
+TEST(MapGuiding, UnbiasedAgainstPlainNee) {
+    const std::vector<std::pair<std::string, std::string>> scenes = {{"lit room", lit_room_xml()},
+                                                                      {"glossy room", kGlossyRoomXml}};
+    for (const auto &[name, xml] : scenes) {
+        const std::string path = write_temp_scene(xml);
+        const BlockMoments nee = block_moments(path, "path", Options(), 6, 64, 101);
+        expect_same_image(nee, guided_moments(path, kMapGuided, 6, 64, 212, nullptr), name + " map-guided");
+        OptionMap mostly_guide = kMapGuided;
+        mostly_guide["guiding_bsdf_fraction"] = "0.1";
+        mostly_guide["shadow_rays"] = "neepp";
+        expect_same_image(nee, guided_moments(path, mostly_guide, 6, 64, 262, nullptr),
+                          name + " map-guided, bsdf_fraction 0.1, NEE++ shadow rays");
+        OptionMap bsdf_only = kMapGuided;
+        bsdf_only["nee"] = "false";
+        expect_same_image(nee, guided_moments(path, bsdf_only, 6, 64, 313, nullptr), name + " map-guided, nee=false");
+    }
+}
+
+TEST(MapGuiding, UnbiasedWithAWrongGuide) {
+    const std::string path = write_temp_scene(lit_room_xml());
+    auto scene = load_scene(path);
+    const BlockMoments nee = block_moments(path, "path", Options(), 6, 64, 101);
+    auto probe = make_integrator("path", with_scene_options(*scene, Options(kMapGuided)));
+    probe->prepare(*scene);
+    const VoxelGrid &grid = *dynamic_cast<const PathIntegrator &>(*probe).shadow_rays().voxel_grid();
+    // Every voxel learned that all its flux comes from one voxel under the floor: most guided directions
+    // then go down into the floor, and none toward the light or the sky.
+    MapGuide wrong(grid);
+    PCG32 rng(8, 8);
+    const uint32_t below = grid.voxel_of(Vec3(0.3f, -0.01f, -0.2f));
+    for (int i = 0; i < 200000; ++i) {
+        const Vec3 p = grid.bounds().lo + grid.bounds().extent() * Vec3(rng.next_float(), rng.next_float(), rng.next_float());
+        wrong.record(p, below, 1.0, 1.0);
+    }
+    wrong.update(nullptr);
+    OptionMap guided = kMapGuided;
+    guided["guiding_bsdf_fraction"] = "0.25";
+    const std::string saved = wrong.save();
+    expect_same_image(nee, guided_moments(path, guided, 12, 64, 414, nullptr, &saved), "map guide pointing down");
+}
+
+TEST(MapGuiding, SameImageToTheBitForASeedAndThreadCount) {
+    const std::string path = write_temp_scene(lit_room_xml());
+    auto render_once = [&](uint64_t seed, const char *form) {
+        auto scene = load_scene(path);
+        OptionMap o = kMapGuided;
+        o["form"] = form;
+        auto integrator = make_integrator("path", with_scene_options(*scene, Options(o)));
+        RenderJob job;
+        job.spp = 24;
+        job.seed = seed;
+        job.threads = 4;
+        return render(*scene, *integrator, job).image;
+    };
+    for (const char *form : {"fast", "reference"}) {
+        const Image a = render_once(9, form), b = render_once(9, form), c = render_once(10, form);
+        ASSERT_EQ(a.data.size(), b.data.size());
+        EXPECT_TRUE(a.data == b.data) << form << ": the same seed and thread count";
+        EXPECT_FALSE(a.data == c.data) << form << ": another seed";
+    }
+}
+
+TEST(MapGuiding, StateCarriesAndMergesTheTotals) {
+    const std::string path = write_temp_scene(lit_room_xml());
+    auto scene = load_scene(path);
+    auto learn = [&](uint64_t seed, int spp) {
+        auto integrator = make_integrator("path", with_scene_options(*scene, Options(kMapGuided)));
+        RenderJob job;
+        job.spp = spp;
+        job.seed = seed;
+        render(*scene, *integrator, job);
+        return std::pair{integrator->save_state(), dynamic_cast<const PathIntegrator &>(*integrator).map_guide()->save()};
+    };
+    const auto [state_a, guide_a] = learn(1, 8);
+    const auto [state_b, guide_b] = learn(2, 16);
+    auto fresh = make_integrator("path", with_scene_options(*scene, Options(kMapGuided)));
+    fresh->prepare(*scene);
+    fresh->restore_state(*scene, state_a);
+    EXPECT_EQ(dynamic_cast<const PathIntegrator &>(*fresh).map_guide()->save(), guide_a);
+    EXPECT_EQ(fresh->save_state(), state_a);
+    // Two renders from nothing: the merged totals are both renders' records.
+    fresh->restore_state(*scene, fresh->merge_states(std::string(), {state_a, state_b}));
+    const std::string both[] = {guide_a, guide_b};
+    EXPECT_EQ(dynamic_cast<const PathIntegrator &>(*fresh).map_guide()->save(), MapGuide::merge("", both));
+    const VoxelGrid &grid = *dynamic_cast<const PathIntegrator &>(*fresh).shadow_rays().voxel_grid();
+    MapGuide a(grid), b(grid);
+    a.load(guide_a);
+    b.load(guide_b);
+    EXPECT_EQ(dynamic_cast<const PathIntegrator &>(*fresh).map_guide()->records(), a.records() + b.records());
+    // An sdtree state is refused by a map-guided integrator, not misread.
+    auto tree = make_integrator("path", with_scene_options(*scene, Options(kGuided)));
+    RenderJob job;
+    job.spp = 2;
+    render(*scene, *tree, job);
+    EXPECT_THROW(fresh->restore_state(*scene, tree->save_state()), std::runtime_error);
 }
 
 }  // namespace

@@ -7,6 +7,7 @@ and Mitsuba 3, skipping with a clear message when one is missing. Run with the p
 """
 from __future__ import annotations
 
+import fcntl
 import os
 import sys
 from pathlib import Path
@@ -53,23 +54,27 @@ def work_dir(tmp_path_factory) -> Path:
     return tmp_path_factory.mktemp("vs_mitsuba")
 
 
-# Modules that start a local Ray instance: kept to one pytest-xdist worker, so that two never run at once.
+# Modules that start a local Ray instance: never two at once, in any worker (a file lock, below).
 _RAY_MODULES = {"test_distributed", "test_distributed_checkpoint"}
 
 
-def pytest_configure(config):
-    config.addinivalue_line("markers", "xdist_group(name): tests that pytest-xdist runs in one worker")
-
-
-def pytest_collection_modifyitems(config, items):
-    # scripts/test.sh runs the suite in two pytest-xdist workers (-n 2 --dist loadgroup): much of a test's
-    # time is not on both cores (Mitsuba's JIT, scene loading, a process starting, waiting on a server), so
-    # two at once finish sooner. Each module's tests go to one worker, so that its module fixtures (a Ray
-    # instance, a server, a memoized reference render) start once and its files in .cache/<module>/ have
-    # one writer.
-    for item in items:
-        name = item.module.__name__.rsplit(".", 1)[-1]
-        item.add_marker(pytest.mark.xdist_group("ray" if name in _RAY_MODULES else name))
+@pytest.fixture(scope="module", autouse=True)
+def _one_ray_module_at_a_time(request):
+    # scripts/test.sh runs the suite in two pytest-xdist workers, each module in one of them (--dist
+    # loadfile: its module fixtures, a server or a memoized reference render, start once, and its files in
+    # .cache/<module>/ have one writer). Two local Ray instances at once on two cores would starve each
+    # other's actors of the time their tests allow; the lock keeps them one after the other.
+    if request.module.__name__.rsplit(".", 1)[-1] not in _RAY_MODULES:
+        yield
+        return
+    lock = REPO / ".cache" / "ray.lock"
+    lock.parent.mkdir(parents=True, exist_ok=True)
+    with open(lock, "w") as f:
+        fcntl.flock(f, fcntl.LOCK_EX)
+        try:
+            yield
+        finally:
+            fcntl.flock(f, fcntl.LOCK_UN)
 
 
 def _sigint_ignored() -> bool:

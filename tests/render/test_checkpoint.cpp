@@ -70,10 +70,11 @@ TEST(Checkpoint, NeeppResumesToTheSameImage) {
     expect_resume_is_exact("path", {{"shadow_rays", "neepp-adaptive"}}, 12, 20);
 }
 
-// Guiding learns an SD-tree from every pass: a resumed render samples the tree the uninterrupted one did.
+// Guiding learns from every pass: a resumed render samples the guide the uninterrupted one did.
 TEST(Checkpoint, GuidedPathResumesToTheSameImage) {
     expect_resume_is_exact("path", {{"guiding", "sdtree"}}, 6, 10);
     expect_resume_is_exact("path", {{"guiding", "sdtree"}, {"shadow_rays", "neepp"}}, 6, 10);
+    expect_resume_is_exact("path", {{"guiding", "map"}}, 6, 10);
 }
 
 TEST(Checkpoint, VisibilityAwareLightSelectionResumesToTheSameImage) {

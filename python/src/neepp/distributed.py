@@ -425,19 +425,33 @@ def main(argv=None) -> int:
     # written with it), continued by the same command with --resume, removed once the image is written.
     checkpoint = a.output + ".checkpoint"
     stopped_by = []
+    rendered = []
 
     def on_sigterm(signum, frame):  # stops as Ctrl-C does: the rounds completed are saved
         stopped_by.append(signum)
-        raise KeyboardInterrupt
+        if not rendered:
+            raise KeyboardInterrupt
+        # Once every round is in, there is nothing left to save for later: the image is written and the
+        # checkpoint removed as for an uninterrupted render (default SIGTERM here would kill the process
+        # with the finished image unwritten and the checkpoint left behind).
 
-    signal.signal(signal.SIGTERM, on_sigterm)
+    previous = signal.signal(signal.SIGTERM, on_sigterm)
+    try:
+        return _render_and_write(a, params, pairs(a.I, "-I"), checkpoint, png, write_images, stopped_by, rendered)
+    finally:
+        signal.signal(signal.SIGTERM, previous)
+
+
+def _render_and_write(a, params, options, checkpoint, png, write_images, stopped_by, rendered):
+    """main's render and writes, under its SIGTERM handler."""
     try:
         image, stats = render(a.scene, spp=a.spp, time=a.time, workers=a.workers, address=a.ray or None,
-                              integrator=a.integrator, options=pairs(a.I, "-I"), seed=a.seed, threads=a.threads,
+                              integrator=a.integrator, options=options, seed=a.seed, threads=a.threads,
                               sampler=a.sampler, progress=None if a.quiet else sys.stderr.isatty() or
                               _LogLines(), checkpoint=checkpoint if a.checkpoint or a.resume else None,
                               checkpoint_every=a.checkpoint, resume=a.resume,
                               on_checkpoint=write_images if a.checkpoint else None, **params)
+        rendered.append(True)  # in the try: a SIGTERM before it is a stop like any other
     except (ValueError, RuntimeError, OSError) as e:
         print(f"neepp: error: {e}", file=sys.stderr)
         return 1
@@ -449,7 +463,6 @@ def main(argv=None) -> int:
             print("neepp: interrupted (a distributed render without --checkpoint keeps no partial image)",
                   file=sys.stderr)
         return 143 if stopped_by else 130
-    signal.signal(signal.SIGTERM, signal.SIG_DFL)
     write_images(image)
     if a.stats:
         _neepp.write_file_atomically(a.stats, lambda tmp: _write_json(tmp, stats))

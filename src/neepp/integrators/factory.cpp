@@ -114,10 +114,9 @@ std::unique_ptr<PathIntegrator> make_path(const Options &options, bool volumetri
         throw std::invalid_argument("form must be 'fast' or 'reference', not '" + form + "'");
     o.reference = form == "reference";
     if (!volumetric) {
-        const std::string guiding = options.get_string("guiding", "none");
-        if (guiding != "none" && guiding != "sdtree")
-            throw std::invalid_argument("guiding must be 'none' or 'sdtree', not '" + guiding + "'");
-        o.guiding = guiding == "sdtree";
+        o.guiding = options.get_string("guiding", "none");
+        if (o.guiding != "none" && o.guiding != "sdtree" && o.guiding != "map")
+            throw std::invalid_argument("guiding must be 'none', 'sdtree' or 'map', not '" + o.guiding + "'");
         o.guiding_bsdf_fraction = options.get_float("guiding_bsdf_fraction", o.guiding_bsdf_fraction);
         if (!(o.guiding_bsdf_fraction > 0.f && o.guiding_bsdf_fraction <= 1.f))
             throw std::invalid_argument("guiding_bsdf_fraction must be in (0, 1]: the BSDF's share keeps guiding unbiased");
@@ -145,7 +144,8 @@ std::unique_ptr<PathIntegrator> make_path(const Options &options, bool volumetri
             throw std::invalid_argument("ris_floor must be in (0, 1]: a target of 0 where light arrives would bias the image");
     }
     // Resampling reads the map whatever the light sampler: its target holds Ṽ.
-    const bool needs_map = light_sampler_needs_visibility_map(o.light_sampler) || o.within_light != "own" || o.ris > 1;
+    const bool needs_map = light_sampler_needs_visibility_map(o.light_sampler) || o.within_light != "own" || o.ris > 1 ||
+                           o.guiding == "map";
     if (o.light_sampler.rfind("spatial", 0) == 0 || o.light_sampler.rfind("bayes", 0) == 0 || needs_map || options.get_string("shadow_rays", "nee") != "nee")
         o.voxels = options.get_int("voxels", o.voxels);
     // A light sampler reading the map needs it from the first pass: no deferred seeding then.

@@ -59,17 +59,19 @@ std::vector<IntegratorDoc> make_docs() {
                             "fast (paths in batches, the default) or reference (one path at a time, the estimator's "
                             "definition: the same image in expectation, slower)", ""});
     path.options.push_back({"guiding", "none",
-                            "none, or sdtree: practical path guiding (Mueller et al. 2017), an SD-tree learned from "
+                            "none; sdtree: practical path guiding (Mueller et al. 2017), an SD-tree learned from "
                             "each pass's paths guides the next direction by one-sample MIS with the BSDF "
-                            "where the BSDF has no delta part; unbiased whatever it learned", ""});
+                            "where the BSDF has no delta part; map: the visibility map's guide, toward the grid's "
+                            "cells by the flux each voxel learned from them, the map's visibility as the prior "
+                            "(docs/neepp.md); unbiased whatever either learned", ""});
     path.options.push_back({"guiding_bsdf_fraction", text(p.guiding_bsdf_fraction),
-                            "guiding=sdtree: the share of next directions the BSDF samples (the rest the guide), "
+                            "guiding: the share of next directions the BSDF samples (the rest the guide), "
                             "in (0, 1]", ""});
     path.options.push_back({"guiding_spatial_threshold", text(float(p.guiding_spatial_threshold)),
                             "guiding=sdtree: c, a spatial leaf of the SD-tree splits past c * sqrt(pass spp) "
                             "records (0: PPG's 12000 scaled by sqrt(pixels / 1280x720))", ""});
     path.options.push_back({"guiding_learn_direct", text(p.guiding_learn_direct),
-                            "guiding=sdtree: the guide learns the emission a guided direction finds directly too "
+                            "guiding: the guide learns the emission a guided direction finds directly too "
                             "(false: only the light next event estimation does not bring)", ""});
     path.options.push_back({"nee", text(p.nee), "next event estimation (false: BSDF sampling only, the paper's Path)", ""});
     path.options.push_back({"light_sampler", p.light_sampler, "which light NEE samples: " + samplers, ""});

@@ -36,7 +36,7 @@ void PathIntegrator::prepare(const Scene &scene) {
     // a map that no shadow-ray policy uses either is not built. Resampling reads it on any scene.
     if (shadow_->policy() == "nee" && shadow_->visibility_map() &&
         !light_sampler_needs_visibility_map(options_.light_sampler, scene.lights().size()) &&
-        options_.within_light == "own" && !resampling())
+        options_.within_light == "own" && !resampling() && options_.guiding != "map")
         shadow_ = std::make_unique<TraceAllShadowRays>();
     shadow_->prepare(scene);  // NEE++: build or load the visibility map
     queries_ = &shadow_->query_tester();
@@ -46,7 +46,12 @@ void PathIntegrator::prepare(const Scene &scene) {
     within_light_ = WithinLightSampling(options_.within_light, scene, shadow_->voxel_grid(), shadow_->visibility_map(),
                                         options_.area_light_sampling);
     refresh_resampling();
-    if (options_.guiding && guide_learns_) {
+    if (options_.guiding == "map" && guide_learns_) {
+        if (!shadow_->voxel_grid())
+            throw std::invalid_argument("guiding=map: the shadow-ray component keeps no visibility map");
+        map_guide_ = std::make_unique<MapGuide>(*shadow_->voxel_grid());
+    }
+    if (options_.guiding == "sdtree" && guide_learns_) {
         SDTreeOptions tree;
         // PPG's c = 12000 is for 1280x720 images: a leaf splits past c·√(pass spp) records, and the
         // records of a pass grow with the pixels, so at the same c a smaller image gets fewer leaves.
@@ -75,6 +80,18 @@ void PathIntegrator::end_pass(const Scene &, const PassStatistics &pass) {
         guide_->update(pass.spp - guide_spp_);
         guide_spp_ = pass.spp;
     }
+    if (map_guide_ && guide_learns_) map_guide_->update(shadow_->visibility_map());
+}
+
+VertexGuide PathIntegrator::vertex_guide(const SurfaceInteraction &si) const {
+    const float f = options_.guiding_bsdf_fraction;
+    return map_guide_ ? guide_at(map_guide_.get(), guide_learns_, si, f) : guide_at(guide_.get(), guide_learns_, si, f);
+}
+
+void PathIntegrator::commit_guide(const GuideRecorder &recorder, const Color &L) const {
+    if (!guide_learns_) return;
+    if (guide_) recorder.commit(*guide_, L);
+    if (map_guide_) recorder.commit(*map_guide_, L);
 }
 
 void PathIntegrator::restore_state(const Scene &, const std::string &state) {
@@ -84,6 +101,10 @@ void PathIntegrator::restore_state(const Scene &, const std::string &state) {
     if (guide_ && guide_learns_ && !parts.guide.empty()) {
         guide_->load(parts.guide);
         guide_spp_ = parts.guide_spp;
+    }
+    if (map_guide_ && guide_learns_ && !parts.guide.empty()) {
+        map_guide_->load(parts.guide);
+        map_guide_->update(shadow_->visibility_map());  // tables from the restored totals and map
     }
     queries_ = &shadow_->query_tester();
     light_sampler_->end_pass();  // its distributions read the restored map
@@ -101,6 +122,7 @@ nlohmann::json PathIntegrator::statistics() const {
     }
     if (within_light_.any()) out["within_light"] = within_light_.statistics();
     if (guide_) out["guiding"] = guide_->statistics();
+    if (map_guide_) out["guiding"] = map_guide_->statistics();
     return out;
 }
 
@@ -117,7 +139,7 @@ nlohmann::json PathIntegrator::describe() const {
             {"ris_floor", options_.ris_floor},
             {"ris_depth", options_.ris_depth},
             {"form", options_.reference || options_.volumetric ? "reference" : "fast"},
-            {"guiding", options_.guiding ? "sdtree" : "none"},
+            {"guiding", options_.guiding},
             {"shadow_rays", shadow_->policy()},
             {"shadow_ray_options", shadow_->describe()}};
 }
@@ -226,12 +248,13 @@ Color PathIntegrator::Li(const Scene &scene, const Ray &camera_ray, Sampler &sam
     LightSampleContext prev;
     float prev_bsdf_pdf = 1.f;
     bool prev_delta = true;  // the camera counts as a delta vertex: no MIS on directly seen lights
-    GuideRecorder recorder;  // guiding=sdtree: what the path tells the guide
+    GuideRecorder recorder;  // guiding: what the path tells the guide
     const bool learn_direct = options_.guiding_learn_direct;
     for (int depth = 0;; ++depth) {
         SurfaceInteraction si;
         const bool hit = scene.intersect(ray, si);
         ++counters.rays;
+        if (depth > 0) recorder.ended(depth - 1, si.p, !hit);
         const bool show_emission = depth > 0 || !options_.hide_emitters;
 
         // Emission along the ray: environments where it escapes, an area light where it lands.
@@ -261,23 +284,23 @@ Color PathIntegrator::Li(const Scene &scene, const Ray &camera_ray, Sampler &sam
 
         // Next event estimation, where the BSDF has a smooth part a light sample can reach.
         const LightSampleContext ctx = light_context(si, ray.d);
-        const VertexGuide guide = guide_at(guide_.get(), guide_learns_, si, options_.guiding_bsdf_fraction);
+        const VertexGuide guide = vertex_guide(si);
         if (options_.nee && (si.shape->bsdf_flags & BSDFSmooth))
             L += sample_direct(scene, si, ctx, beta, candidates_at(depth), sampler, counters);
 
         // The next direction: by the BSDF, or where a guide has learned, by the BSDF or the guide.
         const BSDF &bsdf = *si.shape->bsdf;
-        const float u_choice = guide.tree ? sampler.next_1d() : 0.f;
+        const float u_choice = guide.guides() ? sampler.next_1d() : 0.f;
         const float u1 = sampler.next_1d();
         const Vec2 u2 = sampler.next_2d();
         float own_pdf = 0.f;  // the BSDF's density of a guided sample, for MIS (sample_guided)
-        const BSDFSample bs = guide.tree ? sample_guided(guide, bsdf, si, u_choice, u1, u2, own_pdf)
+        const BSDFSample bs = guide.guides() ? sample_guided(guide, bsdf, si, u_choice, u1, u2, own_pdf)
                                          : bsdf.sample(BSDFContext{}, si, si.wi, u1, u2);
         if (!bs.valid()) break;
         beta *= bs.weight;
         eta *= bs.eta;
         prev = ctx;
-        prev_bsdf_pdf = guide.tree ? own_pdf : bs.pdf;
+        prev_bsdf_pdf = guide.guides() ? own_pdf : bs.pdf;
         prev_delta = (bs.sampled_flags & BSDFDelta) != 0;
         ray = si.spawn_ray(si.to_world(bs.wo));
 
@@ -285,7 +308,7 @@ Color PathIntegrator::Li(const Scene &scene, const Ray &camera_ray, Sampler &sam
         if (!(max_component(beta) > 0)) break;
         if (guide.record) recorder.add(depth, si.p, ray.d, bs.pdf, beta, L);
     }
-    if (guide_ && guide_learns_) recorder.commit(*guide_, L);
+    commit_guide(recorder, L);
     return L;
 }
 

@@ -6,6 +6,7 @@
 #include <memory>
 #include "neepp/base/integrator.h"
 #include "neepp/base/light_sampler.h"
+#include "neepp/guiding/map_guide.h"
 #include "neepp/guiding/sd_tree.h"
 #include "neepp/light_selection/resampling.h"
 #include "neepp/light_selection/within_light_sampling.h"
@@ -38,10 +39,11 @@ struct PathOptions {
     // path (null, a mask's clear part, a thin dielectric's transmission) crossed without counting a bounce,
     // and shadow rays that pass such surfaces and media with their transmittance. Reference form only.
     bool volumetric = false;
-    // Practical path guiding (guiding=sdtree, path_guiding.h): at vertices without a delta BSDF part the
-    // next direction is drawn by one-sample MIS between the BSDF (guiding_bsdf_fraction of the samples) and
-    // an SD-tree learned from the passes before; NEE stays for direct light. Both forms render it.
-    bool guiding = false;
+    // Path guiding (path_guiding.h): at vertices without a delta BSDF part the next direction is drawn by
+    // one-sample MIS between the BSDF (guiding_bsdf_fraction of the samples) and a guide learned from the
+    // passes before: "sdtree" (practical path guiding's SD-tree) or "map" (the visibility map's guide,
+    // map_guide.h); "none" guides nothing. NEE stays for direct light. Both forms render it.
+    std::string guiding = "none";
     // PPG's is 0.5; with NEE on classroom and living-room (docs/performance.md) 0.75 measured less noisy
     // (relVar 0.94x NEE's against 0.98-1.08x) and 0.9 no less noisy than 0.75.
     float guiding_bsdf_fraction = 0.75f;
@@ -55,6 +57,7 @@ struct PathOptions {
 
 class PathBatch;
 struct VertexGuide;
+class GuideRecorder;
 
 class PathIntegrator final : public RayIntegrator {
 public:
@@ -92,6 +95,13 @@ public:
     // that is deliberately wrong for the scene. prepare() keeps it.
     void install_guide(std::unique_ptr<SDTree> tree) {
         guide_ = std::move(tree);
+        guide_learns_ = false;
+    }
+    // guiding=map: the map guide the coming pass samples (null before prepare()), and for tests, one to
+    // guide by from now on that never changes.
+    const MapGuide *map_guide() const { return map_guide_.get(); }
+    void install_map_guide(std::unique_ptr<MapGuide> guide) {
+        map_guide_ = std::move(guide);
         guide_learns_ = false;
     }
 
@@ -140,7 +150,11 @@ private:
     std::unique_ptr<PathBatch> batch_;
     WithinLightSampling within_light_;
     ResamplingVisibility resampling_visibility_;
+    // The guide at a vertex (none, the tree's or the map's), and a path's records into the learning one.
+    VertexGuide vertex_guide(const SurfaceInteraction &si) const;
+    void commit_guide(const GuideRecorder &recorder, const Color &L) const;
     std::unique_ptr<SDTree> guide_;  // guiding=sdtree; records from every thread (SDTree::record is thread-safe)
+    std::unique_ptr<MapGuide> map_guide_;  // guiding=map; likewise
     bool guide_learns_ = true;
     int guide_spp_ = 0;              // samples per pixel the guide has seen, for the size of each pass
 };

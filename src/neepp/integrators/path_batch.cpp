@@ -56,8 +56,8 @@ struct PathBatch::Path {
     // Next event estimation's shadow query, while its ray waits to be traced with the batch's others.
     ShadowQuery shadow;
     ShadowTest test;
-    // guiding=sdtree: the vertex's guide (no tree: the BSDF samples alone), and what the path tells the
-    // guide when it ends (null: it learns nothing).
+    // guiding: the vertex's guide (none: the BSDF samples alone), and what the path tells the guide when
+    // it ends (null: it learns nothing).
     VertexGuide guide;
     GuideRecorder *recorder = nullptr;
 
@@ -81,6 +81,7 @@ bool PathBatch::begin_vertex(const Scene &scene, Path &path) const {
     const PathIntegrator &pi = pi_;  // a local: the stages' stores through path cannot alias it
     const bool show_emission = path.depth > 0 || !pi.options_.hide_emitters;
     const Ray &ray = path.ray;
+    if (path.recorder && path.depth > 0) path.recorder->ended(path.depth - 1, path.si.p, !path.hit.valid());
     if (!path.hit.valid()) {
         if (show_emission)
             for (const Light *env : scene.infinite_lights()) {
@@ -112,7 +113,7 @@ bool PathBatch::begin_vertex(const Scene &scene, Path &path) const {
     const BSDF &bsdf = *si.shape->bsdf;
     bsdf.prefetch(si);
     path.ctx = PathIntegrator::light_context(si, ray.d);
-    path.guide = guide_at(pi.guide_.get(), pi.guide_learns_, si, pi.options_.guiding_bsdf_fraction);
+    path.guide = pi.vertex_guide(si);
     path.nee = pi.options_.nee && (si.shape->bsdf_flags & BSDFSmooth);
     path.m = pi.candidates_at(path.depth);
     if (!path.nee) return true;
@@ -287,17 +288,17 @@ bool PathBatch::finish_vertex(Path &path) const {
     const BSDF &bsdf = *si.shape->bsdf;
     Sampler &sampler = *path.sampler;
     const VertexGuide &guide = path.guide;
-    const float u_choice = guide.tree ? sampler.next_1d() : 0.f;  // in Li's order
+    const float u_choice = guide.guides() ? sampler.next_1d() : 0.f;  // in Li's order
     float u1 = sampler.next_1d();
     Vec2 u2 = sampler.next_2d();
     float own_pdf = 0.f;  // the BSDF's density of a guided sample, for MIS (sample_guided)
-    BSDFSample bs = guide.tree ? sample_guided(guide, bsdf, si, u_choice, u1, u2, own_pdf)
+    BSDFSample bs = guide.guides() ? sample_guided(guide, bsdf, si, u_choice, u1, u2, own_pdf)
                                : bsdf.sample(BSDFContext{}, si, si.wi, u1, u2);
     if (!bs.valid()) return false;
     path.beta *= bs.weight;
     path.eta *= bs.eta;
     path.prev = path.ctx;
-    path.prev_bsdf_pdf = guide.tree ? own_pdf : bs.pdf;
+    path.prev_bsdf_pdf = guide.guides() ? own_pdf : bs.pdf;
     path.prev_delta = (bs.sampled_flags & BSDFDelta) != 0;
     path.ray = si.spawn_ray(si.to_world(bs.wo));
     ++path.depth;
@@ -324,14 +325,14 @@ void PathBatch::Li_batch(const Scene &scene, std::span<const Ray> rays, std::spa
         std::array<Path, kBatch> paths;
         std::array<uint32_t, kBatch> active, pending;
         std::vector<Candidate> candidates;  // each path's options.ris, one after another
-        std::vector<GuideRecorder> recorders;  // guiding=sdtree while the guide learns: one per path
+        std::vector<GuideRecorder> recorders;  // guiding while the guide learns: one per path
     };
     thread_local std::unique_ptr<Slots> slots;
     if (!slots) slots = std::make_unique<Slots>();
     auto &[paths, active, pending, candidates, recorders] = *slots;
     const size_t M = size_t(pi.options_.ris);
     if (candidates.size() < kBatch * M) candidates.resize(kBatch * M);
-    SDTree *const learning = pi.guide_learns_ ? pi.guide_.get() : nullptr;
+    const bool learning = pi.guide_learns_ && (pi.guide_ || pi.map_guide_);
     if (learning && recorders.size() < kBatch) recorders.resize(kBatch);
     for (size_t base = 0; base < rays.size(); base += kBatch) {
         const size_t n = std::min(kBatch, rays.size() - base);
@@ -395,7 +396,7 @@ void PathBatch::Li_batch(const Scene &scene, std::span<const Ray> rays, std::spa
         }
         for (size_t i = 0; i < n; ++i) out[base + i] = paths[i].L;
         if (learning)
-            for (size_t i = 0; i < n; ++i) recorders[i].commit(*learning, paths[i].L);
+            for (size_t i = 0; i < n; ++i) pi.commit_guide(recorders[i], paths[i].L);
     }
 }
 

@@ -4,18 +4,43 @@
 
 namespace neepp {
 
-VertexGuide guide_at(SDTree *tree, bool learn, const SurfaceInteraction &si, float bsdf_fraction) {
-    VertexGuide g;
+namespace {
+
+bool guidable(const SurfaceInteraction &si) {
     const uint32_t flags = si.shape->bsdf_flags;
-    if (!tree || (flags & BSDFDelta) || !(flags & BSDFSmooth)) return g;
+    return !(flags & BSDFDelta) && (flags & BSDFSmooth);
+}
+
+void set_mixture(VertexGuide &g, const SurfaceInteraction &si, float bsdf_fraction) {
+    g.bsdf_fraction = bsdf_fraction;
+    g.fold = !(si.shape->bsdf_flags & BSDFTransmission);
+    const Vec3 n = si.sh_frame.n;
+    g.up = dot(si.to_world(si.wi), n) >= 0 ? n : -n;
+}
+
+}  // namespace
+
+VertexGuide guide_at(const SDTree *tree, bool learn, const SurfaceInteraction &si, float bsdf_fraction) {
+    VertexGuide g;
+    if (!tree || !guidable(si)) return g;
     g.record = learn;
     g.leaf = tree->leaf_at(si.p);
     if (tree->can_guide(g.leaf)) {
         g.tree = tree;
-        g.bsdf_fraction = bsdf_fraction;
-        g.fold = !(flags & BSDFTransmission);
-        const Vec3 n = si.sh_frame.n;
-        g.up = dot(si.to_world(si.wi), n) >= 0 ? n : -n;
+        set_mixture(g, si, bsdf_fraction);
+    }
+    return g;
+}
+
+VertexGuide guide_at(const MapGuide *map, bool learn, const SurfaceInteraction &si, float bsdf_fraction) {
+    VertexGuide g;
+    if (!map || !guidable(si)) return g;
+    g.record = learn;
+    if (const MapGuide::Table *t = map->table_at(si.p)) {
+        g.map = map;
+        g.table = t;
+        g.p = si.p;
+        set_mixture(g, si, bsdf_fraction);
     }
     return g;
 }
@@ -32,7 +57,10 @@ BSDFSample sample_guided(const VertexGuide &g, const BSDF &bsdf, const SurfaceIn
         return bs;
     }
     BSDFSample bs;
-    const Vec3 d = g.sample(u2);
+    // The choice's own uniform, rescaled to [0, 1), picks the map guide's cell.
+    const float u_pick = std::min((u_choice - g.bsdf_fraction) / (1.f - g.bsdf_fraction), kOneMinusEpsilon);
+    const Vec3 d = g.sample(u_pick, u1, u2);
+    if (!(squared_norm(d) > 0)) return BSDFSample{};
     bs.wo = si.to_local(d);
     const BSDFEval e = bsdf.eval_pdf(BSDFContext{}, si, si.wi, bs.wo);
     // The tree's density of d as pdf() gives it, which is the one the BSDF-sampled branch sees too.
@@ -45,14 +73,23 @@ BSDFSample sample_guided(const VertexGuide &g, const BSDF &bsdf, const SurfaceIn
     return bs;
 }
 
+double GuideRecorder::Vertex::arrived(const Color &L_end) const {
+    double sum = 0;
+    for (int c = 0; c < 3; ++c)
+        if (beta[c] > 0) sum += double(L_end[c] - L[c] - direct[c]) / double(beta[c]);
+    return std::max(sum, 0.0) / 3.0;
+}
+
 void GuideRecorder::commit(SDTree &tree, const Color &L) const {
+    for (int i = 0; i < n_; ++i) tree.record(v_[i].p, v_[i].d, v_[i].arrived(L) / double(v_[i].pdf));
+}
+
+void GuideRecorder::commit(MapGuide &map, const Color &L) const {
     for (int i = 0; i < n_; ++i) {
         const Vertex &v = v_[i];
-        // Per channel, where the throughput lets the channel through; the tree keeps their mean.
-        double arrived = 0;
-        for (int c = 0; c < 3; ++c)
-            if (v.beta[c] > 0) arrived += double(L[c] - v.L[c] - v.direct[c]) / double(v.beta[c]);
-        tree.record(v.p, v.d, std::max(arrived, 0.0) / 3.0 / double(v.pdf));
+        const uint32_t target = v.end_kind == kOpen ? MapGuide::kNoTarget : map.target_of(v.end, v.d, v.end_kind == kEscaped);
+        const double arrived = v.arrived(L);
+        map.record(v.p, target, arrived / double(v.pdf), arrived);
     }
 }
 

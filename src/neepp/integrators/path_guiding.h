@@ -1,19 +1,24 @@
-// Practical path guiding (Müller et al. 2017) at a scattering vertex of the path integrator's reference
-// form: the next direction drawn by one-sample MIS between the BSDF (probability bsdf_fraction) and the
-// SD-tree's leaf, weighted by the mixture's density. The BSDF's share is never zero, so every direction
-// the BSDF can reach stays reachable whatever the tree says: the estimate is unbiased for any tree, a
+// Path guiding at a scattering vertex of the path integrator (both forms): the next direction drawn by
+// one-sample MIS between the BSDF (probability bsdf_fraction) and a guide, weighted by the mixture's
+// density. The guide is practical path guiding's SD-tree (Müller et al. 2017; guiding=sdtree) or the
+// visibility map's guide (guiding=map, map_guide.h). The BSDF's share is never zero, so every direction
+// the BSDF can reach stays reachable whatever the guide says: the estimate is unbiased for any guide, a
 // wrong one only costs variance. Vertices whose BSDF has a delta part are left to the BSDF.
 #pragma once
 #include <array>
 #include "neepp/base/bsdf.h"
 #include "neepp/base/interaction.h"
+#include "neepp/guiding/map_guide.h"
 #include "neepp/guiding/sd_tree.h"
 
 namespace neepp {
 
 struct VertexGuide {
-    const SDTree *tree = nullptr;  // null: the BSDF samples alone
+    const SDTree *tree = nullptr;  // guiding=sdtree: the tree and the vertex's leaf
     uint32_t leaf = 0;
+    const MapGuide *map = nullptr;  // guiding=map: the guide, the vertex voxel's table and the vertex
+    const MapGuide::Table *table = nullptr;
+    Vec3 p;
     float bsdf_fraction = 1.f;
     bool record = false;           // the vertex's sampled direction is recorded into the tree
     // Where the BSDF only reflects, the guide's directions are folded onto the side it reflects to (that
@@ -23,26 +28,35 @@ struct VertexGuide {
     bool fold = false;
     Vec3 up;
     static Vec3 mirror(const Vec3 &d, const Vec3 &n) { return d - n * (2.f * dot(d, n)); }
+    // Whether a guide samples here (else the BSDF alone).
+    bool guides() const { return tree || table; }
+    // The unfolded guide's density of d, and a direction from it (u_pick, u1: the map guide's cell and
+    // point; the tree reads u2 only).
+    float raw_pdf(const Vec3 &d) const { return tree ? tree->pdf(leaf, d) : map->pdf(*table, p, d); }
+    Vec3 raw_sample(float u_pick, float u1, Vec2 u2) const {
+        return tree ? tree->sample(leaf, u2) : map->sample(*table, p, u_pick, u1, u2);
+    }
     // The guide's own density of direction d.
     float guide_pdf(const Vec3 &d) const {
-        if (!fold) return tree->pdf(leaf, d);
+        if (!fold) return raw_pdf(d);
         if (!(dot(d, up) > 0)) return 0.f;
-        return tree->pdf(leaf, d) + tree->pdf(leaf, mirror(d, up));
+        return raw_pdf(d) + raw_pdf(mirror(d, up));
     }
-    // A direction from the guide alone, with density guide_pdf.
-    Vec3 sample(Vec2 u) const {
-        const Vec3 d = tree->sample(leaf, u);
+    // A direction from the guide alone, with density guide_pdf (a zero vector: none).
+    Vec3 sample(float u_pick, float u1, Vec2 u2) const {
+        const Vec3 d = raw_sample(u_pick, u1, u2);
         return fold && dot(d, up) < 0 ? mirror(d, up) : d;
     }
     // The density with which the vertex samples world direction d, the BSDF's own density being bsdf_pdf:
     // what weighs the sample.
     float pdf(const Vec3 &d, float bsdf_pdf) const {
-        return tree ? bsdf_fraction * bsdf_pdf + (1.f - bsdf_fraction) * guide_pdf(d) : bsdf_pdf;
+        return guides() ? bsdf_fraction * bsdf_pdf + (1.f - bsdf_fraction) * guide_pdf(d) : bsdf_pdf;
     }
 };
 
-// The guide at a vertex (tree may be null: no guiding). learn: record into the tree.
-VertexGuide guide_at(SDTree *tree, bool learn, const SurfaceInteraction &si, float bsdf_fraction);
+// The guide at a vertex (tree or map null: no guiding). learn: the vertex's direction is recorded.
+VertexGuide guide_at(const SDTree *tree, bool learn, const SurfaceInteraction &si, float bsdf_fraction);
+VertexGuide guide_at(const MapGuide *map, bool learn, const SurfaceInteraction &si, float bsdf_fraction);
 
 // The next direction by one-sample MIS: u_choice picks the strategy, (u1, u2) drive it. The sample's pdf
 // is the mixture's and its weight f·|cos| / pdf; bsdf_pdf receives the BSDF's own density of it. A
@@ -63,7 +77,15 @@ class GuideRecorder {
 public:
     // The vertex at path depth `depth` (the camera's first hit is 0).
     void add(int depth, const Vec3 &p, const Vec3 &d, float pdf, const Color &beta, const Color &L) {
-        if (n_ < int(v_.size())) v_[n_++] = {p, d, pdf, beta, L, Color(0.f), depth};
+        if (n_ < int(v_.size())) v_[n_++] = {p, d, Vec3(0.f), pdf, beta, L, Color(0.f), depth, kOpen};
+    }
+    // Where the ray of the direction chosen at depth `depth` ended: at `end`, or it left the scene (the
+    // map guide files the record under that cell).
+    void ended(int depth, const Vec3 &end, bool escaped) {
+        if (n_ > 0 && v_[n_ - 1].depth == depth && v_[n_ - 1].end_kind == kOpen) {
+            v_[n_ - 1].end = end;
+            v_[n_ - 1].end_kind = escaped ? kEscaped : kHit;
+        }
     }
     // Emission that the direction chosen at depth `depth` found directly, as the path gathered it (its
     // MIS weight included): left out of that vertex's record when the guide learns only the light that
@@ -71,16 +93,22 @@ public:
     void found_emission(int depth, const Color &contribution) {
         if (n_ > 0 && v_[n_ - 1].depth == depth) v_[n_ - 1].direct += contribution;
     }
-    // Records every vertex into the tree, L being all the path gathered.
+    // Records every vertex into the guide, L being all the path gathered.
     void commit(SDTree &tree, const Color &L) const;
+    void commit(MapGuide &map, const Color &L) const;
     void clear() { n_ = 0; }
 
 private:
+    enum EndKind : uint8_t { kOpen, kHit, kEscaped };
     struct Vertex {
-        Vec3 p, d;
+        Vec3 p, d, end;
         float pdf;
         Color beta, L, direct;
         int depth;
+        EndKind end_kind;
+        // The radiance that arrived along d: what the path gathered after the vertex over its throughput
+        // then, per channel where the throughput lets the channel through, their mean.
+        double arrived(const Color &L_end) const;
     };
     std::array<Vertex, 64> v_;  // longer paths record their first 64 vertices
     int n_ = 0;

@@ -64,7 +64,9 @@ PathState PathState::decode(const std::string &bytes, bool framed) {
     return s;
 }
 
-bool PathIntegrator::framed_state() const { return options_.guiding || light_sampler_learns(options_.light_sampler); }
+bool PathIntegrator::framed_state() const {
+    return options_.guiding != "none" || light_sampler_learns(options_.light_sampler);
+}
 
 std::string PathIntegrator::save_state() const {
     PathState s;
@@ -73,31 +75,36 @@ std::string PathIntegrator::save_state() const {
         s.guide = guide_->save();
         s.guide_spp = guide_spp_;
     }
+    if (map_guide_ && guide_learns_) s.guide = map_guide_->save();
     if (learner_) s.light = learner_->save_state();
     return s.encode(framed_state());
 }
 
-// The shadow-ray states merged as the component merges them; the trees by SDTree::merge, the guided
+// The shadow-ray states merged as the component merges them; the trees by SDTree::merge, the map guides
+// by MapGuide::merge (the base's totals plus what each render added), the guided
 // renders' sample counts by the largest (it only scales the spatial split threshold); a learning light
 // sampler's states by its own merge (which needs no prepared sampler: this integrator may be a fresh one).
 std::string PathIntegrator::merge_states(const std::string &base, const std::vector<std::string> &learned) const {
     if (!framed_state()) return shadow_->merge_states(base, learned);
     if (learned.empty()) return base;
     const PathState b = PathState::decode(base, true);
-    std::vector<std::string> shadows, lights;
+    std::vector<std::string> shadows, lights, map_guides;
     std::vector<SDTree> trees;
     PathState merged;
     for (const std::string &l : learned) {
         PathState s = PathState::decode(l, true);
         shadows.push_back(std::move(s.shadow));
         lights.push_back(std::move(s.light));
-        if (!s.guide.empty()) trees.push_back(SDTree::decode(s.guide));
+        if (!s.guide.empty() && options_.guiding == "map") map_guides.push_back(std::move(s.guide));
+        else if (!s.guide.empty()) trees.push_back(SDTree::decode(s.guide));
         merged.guide_spp = std::max(merged.guide_spp, s.guide_spp);
     }
     merged.shadow = shadow_->merge_states(b.shadow, shadows);
     std::vector<const SDTree *> pointers;
     for (const SDTree &t : trees) pointers.push_back(&t);
-    merged.guide = pointers.empty() ? b.guide : SDTree::merge(pointers).save();
+    merged.guide = !map_guides.empty() ? MapGuide::merge(b.guide, map_guides)
+                   : pointers.empty()  ? b.guide
+                                       : SDTree::merge(pointers).save();
     merged.light = merge_light_selection_states(options_.light_sampler, b.light, lights);
     return merged.encode(true);
 }

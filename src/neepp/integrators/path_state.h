@@ -1,5 +1,6 @@
 // What the path integrator carries between passes for checkpoints and distributed rounds: the shadow-ray
-// component's state, with guiding=sdtree the SD-tree and the samples per pixel it has seen, and with a light
+// component's state, with guiding=sdtree the SD-tree and the samples per pixel it has seen (guiding=map: the
+// map guide's totals), and with a light
 // sampler that learns (light_selection_learner.h) what it learned. Without either the state is the
 // shadow-ray component's alone, as it always was.
 #pragma once
@@ -10,7 +11,7 @@ namespace neepp {
 
 struct PathState {
     std::string shadow;
-    std::string guide;   // SDTree::save(); empty: none yet
+    std::string guide;   // SDTree::save() or MapGuide::save(); empty: none yet
     int32_t guide_spp = 0;
     std::string light;   // the learning light sampler's; empty: none
 

@@ -9,7 +9,6 @@
 namespace neepp {
 
 namespace {
-constexpr float kOneMinusEpsilon = 0x1.fffffep-1f;
 constexpr char kMagic[8] = {'N', 'E', 'E', 'P', 'P', 'B', 'L', '1'};
 }  // namespace
 

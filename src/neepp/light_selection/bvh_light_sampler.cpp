@@ -7,8 +7,6 @@ namespace neepp {
 
 namespace {
 
-constexpr float kOneMinusEpsilon = 0x1.fffffep-1f;
-
 // Conty & Kulla's orientation measure: the solid angle (cosine-weighted beyond theta_o) into which a
 // cone of normals with emission spread theta_e can send light.
 float orientation_measure(const LightBounds &b) {

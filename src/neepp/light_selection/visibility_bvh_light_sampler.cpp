@@ -4,10 +4,6 @@
 
 namespace neepp {
 
-namespace {
-constexpr float kOneMinusEpsilon = 0x1.fffffep-1f;
-}
-
 VisibilityBVHLightSampler::VisibilityBVHLightSampler(std::vector<const Light *> lights, const VoxelGrid &grid,
                                                      const VisibilityMap &map, const Vec3 &reference, float epsilon,
                                                      float delta)

@@ -11,6 +11,8 @@ constexpr float kInvPi = 0.31830988618379067154f;
 constexpr float kInv2Pi = 0.15915494309189533577f;
 constexpr float kInv4Pi = 0.07957747154594766788f;
 constexpr float kInfinity = 1e30f;
+// The largest float below 1: a uniform rescaled into [0, 1) stays below 1.
+constexpr float kOneMinusEpsilon = 0x1.fffffep-1f;
 
 struct Vec2 {
     float x = 0, y = 0;

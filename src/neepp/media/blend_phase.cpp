@@ -4,13 +4,6 @@
 
 namespace neepp {
 
-namespace {
-
-// The largest float below 1: a rescaled random number must stay in [0, 1).
-constexpr float kOneMinusEpsilon = 0x1.fffffep-1f;
-
-}  // namespace
-
 BlendPhase::BlendPhase(std::shared_ptr<const PhaseFunction> first, std::shared_ptr<const PhaseFunction> second,
                        std::shared_ptr<const Volume> weight)
     : first_(std::move(first)), second_(std::move(second)), weight_(std::move(weight)) {}

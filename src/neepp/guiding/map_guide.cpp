@@ -1,0 +1,409 @@
+#include "neepp/guiding/map_guide.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <limits>
+#include <map>
+#include <stdexcept>
+#include "neepp/io/binary_io.h"
+#include "neepp/visibility/visibility_map.h"
+
+namespace neepp {
+
+namespace {
+
+constexpr char kMagic[8] = {'N', 'E', 'E', 'P', 'P', 'M', 'G', '1'};
+constexpr uint64_t kSaturate = uint64_t(1) << 62;
+
+// v · 2^exponent as an integer, saturating; what is not a finite number >= 0 counts as 0.
+uint64_t fixed(double v, int exponent) {
+    if (!(v > 0) || !std::isfinite(v)) return 0;
+    const double x = std::ldexp(v, exponent);
+    return x < double(kSaturate) ? uint64_t(x) : kSaturate;
+}
+
+// A direction bin's patch spans 2/S of its cube face along each side, so a direction drawn uniformly on
+// the patch has area density (S/2)² on the face at distance 1, and solid-angle density (S/2)² · r³ with
+// r = 1 / max|d_k| the distance to the face along unit d.
+float bin_density(const Vec3 &d) {
+    constexpr float S = float(VoxelGrid::kDirectionBinsPerFaceSide);
+    const float m = std::max({std::abs(d.x), std::abs(d.y), std::abs(d.z)});
+    return m > 0 ? (S * 0.5f) * (S * 0.5f) / (m * m * m) : 0.f;
+}
+
+}  // namespace
+
+MapGuide::MapGuide(const VoxelGrid &grid, MapGuideOptions options)
+    : grid_(grid), options_(options), cell_size_(grid.bounds().extent() / float(grid.resolution())),
+      voxels_(grid.voxel_count()), locks_(new std::mutex[kStripes]) {}
+
+void MapGuide::record(const Vec3 &p, uint32_t target, double flux, double radiance) {
+    const uint32_t i = grid_.voxel_of(p);
+    Voxel &v = voxels_[i];
+    std::lock_guard<std::mutex> lock(locks_[i % kStripes]);
+    ++v.pass_samples;
+    if (target == kNoTarget || target >= grid_.cell_count()) return;
+    Acc &a = v.pass[target];
+    a.flux += fixed(flux, scale_exponent_);
+    a.radiance += fixed(radiance, scale_exponent_);
+    ++a.count;
+}
+
+void MapGuide::update(const VisibilityMap *map) {
+    // The pass's sums join the totals. Each (voxel, target) total receives one addition per pass, so the
+    // order of this loop changes nothing.
+    unsigned __int128 flux = 0;  // exact, whatever the order
+    uint64_t records = 0;
+    for (Voxel &v : voxels_) {
+        for (const auto &[target, a] : v.pass) {
+            Total &t = v.total[target];
+            t.flux += std::ldexp(double(a.flux), -scale_exponent_);
+            t.radiance += std::ldexp(double(a.radiance), -scale_exponent_);
+            t.count += a.count;
+            flux += a.flux;
+        }
+        v.samples += v.pass_samples;
+        records += v.pass_samples;
+        v.pass.clear();
+        v.pass_samples = 0;
+    }
+    records_ += records;
+    // The next pass's fixed-point scale: ~2^24 steps below the mean record, a power of two (exact).
+    if (records > 0 && flux > 0) {
+        const double mean = std::ldexp(double(flux), -scale_exponent_) / double(records);
+        scale_exponent_ = std::clamp(24 - int(std::ceil(std::log2(mean))), -60, 60);
+    }
+    build_tables(map);
+}
+
+void MapGuide::build_tables(const VisibilityMap *map) {
+    tables_.clear();
+    table_of_voxel_.assign(grid_.voxel_count(), -1);
+    const uint32_t cells = grid_.cell_count();
+    // What each cell sends out: the mean radiance of the recorded rays that ended in it.
+    std::vector<double> radiance(cells, 0.0);
+    std::vector<uint64_t> count(cells, 0);
+    for (const Voxel &v : voxels_)
+        for (const auto &[target, t] : v.total) {
+            radiance[target] += t.radiance;
+            count[target] += t.count;
+        }
+    std::vector<uint32_t> bright;
+    for (uint32_t j = 0; j < cells; ++j)
+        if (count[j] > 0 && radiance[j] > 0) {
+            radiance[j] /= double(count[j]);
+            bright.push_back(j);
+        } else {
+            radiance[j] = 0;
+        }
+    // The voxels that get a table: the most-recorded ones, as many as the memory bound allows.
+    std::vector<uint32_t> order;
+    for (uint32_t i = 0; i < grid_.voxel_count(); ++i)
+        if (voxels_[i].samples > 0) order.push_back(i);
+    const size_t per_table = size_t(cells) * sizeof(float) * 2;
+    const size_t most = std::max<size_t>(1, options_.max_table_bytes / per_table);
+    if (order.size() > most) {
+        std::stable_sort(order.begin(), order.end(),
+                         [&](uint32_t a, uint32_t b) { return voxels_[a].samples > voxels_[b].samples; });
+        order.resize(most);
+        std::sort(order.begin(), order.end());
+    }
+    const Vec3 e = cell_size_;
+    // A voxel's solid angle from a distance d: its mean projected area (a quarter of its surface, for a
+    // convex body) over d², at most a hemisphere; a direction bin: its share of the sphere.
+    const double mean_area = 0.5 * (double(e.x) * e.y + double(e.y) * e.z + double(e.z) * e.x);
+    const double bin_solid_angle = 4.0 * M_PI / VoxelGrid::kDirectionBins;
+    const double k = options_.prior_records;
+    auto center = [&](uint32_t cell) {
+        int x, y, z;
+        grid_.voxel_coords(cell, x, y, z);
+        return grid_.bounds().lo + Vec3(float(x) + 0.5f, float(y) + 0.5f, float(z) + 0.5f) * e;
+    };
+    std::vector<double> w(cells);
+    for (uint32_t i : order) {
+        const Voxel &v = voxels_[i];
+        std::fill(w.begin(), w.end(), 0.0);
+        const double n = double(v.samples);
+        // Learned: the summed flux from each target (n times the mean flux estimate).
+        for (const auto &[target, t] : v.total) w[target] += t.flux / (n + k);
+        if (map && k > 0) {
+            const Vec3 ci = center(i);
+            for (uint32_t j : bright) {
+                double solid_angle = bin_solid_angle;
+                if (!grid_.is_direction_cell(j)) {
+                    const double d2 = double(squared_norm(center(j) - ci));
+                    solid_angle = d2 > 0 ? std::min(2.0 * M_PI, mean_area / d2) : 2.0 * M_PI;
+                }
+                w[j] += k * double(map->estimate(i, j)) * radiance[j] * solid_angle / (n + k);
+            }
+        }
+        double sum = 0;
+        for (double x : w) sum += x;
+        if (!(sum > 0) || !std::isfinite(sum)) continue;
+        Table t;
+        t.pmf.assign(cells, 0.f);
+        double running = 0;
+        for (uint32_t j = 0; j < cells; ++j) {
+            const float p = float(w[j] / sum);
+            if (!(p > 0)) continue;
+            t.pmf[j] = p;
+            running += double(p);
+            t.cells.push_back(j);
+            t.cdf.push_back(float(running));
+        }
+        if (t.cells.empty()) continue;
+        // The float pmf sums to `running`, not exactly 1: scale both so that density and sampling agree.
+        const float scale = float(1.0 / running);
+        for (float &p : t.pmf) p *= scale;
+        for (float &c : t.cdf) c *= scale;
+        t.cdf.back() = 1.f;
+        table_of_voxel_[i] = int32_t(tables_.size());
+        tables_.push_back(std::move(t));
+    }
+}
+
+Vec3 MapGuide::sample(const Table &t, const Vec3 &p, float u_cell, float u1, Vec2 u2) const {
+    const size_t at = std::min<size_t>(size_t(std::upper_bound(t.cdf.begin(), t.cdf.end(), u_cell) - t.cdf.begin()),
+                                       t.cells.size() - 1);
+    const uint32_t j = t.cells[at];
+    if (grid_.is_direction_cell(j)) return grid_.direction_in_bin(j, u2);
+    int x, y, z;
+    grid_.voxel_coords(j, x, y, z);
+    const Vec3 target = grid_.bounds().lo + Vec3(float(x) + u1, float(y) + u2.x, float(z) + u2.y) * cell_size_;
+    const Vec3 d = target - p;
+    const float len = norm(d);
+    return len > 0 && std::isfinite(len) ? d / len : Vec3(0.f);
+}
+
+float MapGuide::pdf(const Table &t, const Vec3 &p, const Vec3 &d) const {
+    return t.pmf[grid_.cell_of_direction(d)] * bin_density(d) + voxel_part(t, p, d);
+}
+
+// A uniform point of a box of volume V seen from p: along unit d the ray crosses the box over [t0, t1],
+// and the direction's solid-angle density is ∫ t² dt / V = (t1³ - t0³) / 3V. Summed over the voxels the
+// ray from p crosses (a 3D DDA through the grid), each weighted by its pmf.
+float MapGuide::voxel_part(const Table &t, const Vec3 &p, const Vec3 &d) const {
+    const BBox &b = grid_.bounds();
+    float t0 = 0.f, t1 = std::numeric_limits<float>::infinity();
+    for (int a = 0; a < 3; ++a) {
+        if (d[a] != 0.f) {
+            const float ta = (b.lo[a] - p[a]) / d[a], tb = (b.hi[a] - p[a]) / d[a];
+            t0 = std::max(t0, std::min(ta, tb));
+            t1 = std::min(t1, std::max(ta, tb));
+        } else if (p[a] < b.lo[a] || p[a] > b.hi[a]) {
+            return 0.f;
+        }
+    }
+    if (!(t0 < t1)) return 0.f;
+    const int n = grid_.resolution();
+    int ix[3], step[3];
+    float next[3], delta[3];
+    for (int a = 0; a < 3; ++a) {
+        const float q = p[a] + d[a] * t0;
+        ix[a] = std::clamp(int((q - b.lo[a]) / cell_size_[a]), 0, n - 1);
+        if (d[a] > 0.f) {
+            step[a] = 1;
+            next[a] = (b.lo[a] + float(ix[a] + 1) * cell_size_[a] - p[a]) / d[a];
+            delta[a] = cell_size_[a] / d[a];
+        } else if (d[a] < 0.f) {
+            step[a] = -1;
+            next[a] = (b.lo[a] + float(ix[a]) * cell_size_[a] - p[a]) / d[a];
+            delta[a] = -cell_size_[a] / d[a];
+        } else {
+            step[a] = 0;
+            next[a] = std::numeric_limits<float>::infinity();
+            delta[a] = 0.f;
+        }
+    }
+    double sum = 0;
+    double tc = t0, tc3 = double(t0) * t0 * t0;
+    for (int guard = 0; guard < 3 * n + 3; ++guard) {
+        const int a = next[0] < next[1] ? (next[0] < next[2] ? 0 : 2) : (next[1] < next[2] ? 1 : 2);
+        const double tn = std::max(tc, double(std::min(next[a], t1)));
+        const double tn3 = tn * tn * tn;
+        const float pm = t.pmf[uint32_t(ix[0] + n * (ix[1] + n * ix[2]))];
+        if (pm > 0.f) sum += double(pm) * (tn3 - tc3);
+        tc = tn;
+        tc3 = tn3;
+        if (tn >= double(t1)) break;
+        ix[a] += step[a];
+        if (ix[a] < 0 || ix[a] >= n) break;
+        next[a] += delta[a];
+    }
+    const double volume = double(cell_size_.x) * cell_size_.y * cell_size_.z;
+    return float(sum / (3.0 * volume));
+}
+
+nlohmann::json MapGuide::statistics() const {
+    size_t targets = 0;
+    for (const Table &t : tables_) targets += t.cells.size();
+    return {{"kind", "map"},
+            {"tables", tables_.size()},
+            {"targets_mean", tables_.empty() ? 0.0 : double(targets) / double(tables_.size())},
+            {"records", records_}};
+}
+
+// Totals in ascending (voxel, target) order, so that equal guides save equal bytes.
+std::string MapGuide::save() const {
+    BinaryWriter w{std::string(kMagic, sizeof kMagic)};
+    w.put(int32_t(grid_.resolution()));
+    w.put(grid_.bounds().lo);
+    w.put(grid_.bounds().hi);
+    w.put(int32_t(scale_exponent_));
+    w.put(uint64_t(records_));
+    uint32_t used = 0;
+    for (const Voxel &v : voxels_) used += v.samples > 0 ? 1 : 0;
+    w.put(used);
+    for (uint32_t i = 0; i < voxels_.size(); ++i) {
+        const Voxel &v = voxels_[i];
+        if (v.samples == 0) continue;
+        w.put(i);
+        w.put(uint64_t(v.samples));
+        std::vector<uint32_t> targets;
+        for (const auto &[target, t] : v.total) targets.push_back(target);
+        std::sort(targets.begin(), targets.end());
+        w.put(uint32_t(targets.size()));
+        for (uint32_t target : targets) {
+            const Total &t = v.total.at(target);
+            w.put(target);
+            w.put(t.flux);
+            w.put(t.radiance);
+            w.put(uint64_t(t.count));
+        }
+    }
+    return std::move(w.bytes);
+}
+
+namespace {
+
+struct Saved {
+    int32_t resolution = 0;
+    Vec3 lo, hi;
+    int32_t scale = 0;
+    uint64_t records = 0;
+    // voxel -> (samples, target -> (flux, radiance, count))
+    struct Totals {
+        double flux = 0, radiance = 0;
+        uint64_t count = 0;
+    };
+    std::map<uint32_t, std::pair<uint64_t, std::map<uint32_t, Totals>>> voxels;
+};
+
+Saved decode(std::string_view bytes) {
+    if (bytes.size() < sizeof kMagic || std::memcmp(bytes.data(), kMagic, sizeof kMagic) != 0)
+        throw std::runtime_error("guide: not a map guide's state");
+    BinaryReader r{bytes, sizeof kMagic, "guide: map guide"};
+    Saved s;
+    s.resolution = r.get<int32_t>();
+    s.lo = r.get<Vec3>();
+    s.hi = r.get<Vec3>();
+    s.scale = r.get<int32_t>();
+    s.records = r.get<uint64_t>();
+    if (s.resolution < 1 || s.resolution > VoxelGrid::kMaxResolution) throw std::runtime_error("guide: bad map guide grid");
+    const uint64_t voxels = uint64_t(s.resolution) * s.resolution * s.resolution;
+    const uint64_t cells = voxels + VoxelGrid::kDirectionBins;
+    const uint32_t used = r.get<uint32_t>();
+    if (used > voxels) throw std::runtime_error("guide: bad map guide size");
+    for (uint32_t u = 0; u < used; ++u) {
+        const uint32_t i = r.get<uint32_t>();
+        if (i >= voxels || s.voxels.count(i)) throw std::runtime_error("guide: bad map guide voxel");
+        auto &[samples, targets] = s.voxels[i];
+        samples = r.get<uint64_t>();
+        const uint32_t n = r.get<uint32_t>();
+        if (n > cells) throw std::runtime_error("guide: bad map guide size");
+        for (uint32_t k = 0; k < n; ++k) {
+            const uint32_t target = r.get<uint32_t>();
+            if (target >= cells || targets.count(target)) throw std::runtime_error("guide: bad map guide target");
+            Saved::Totals &t = targets[target];
+            t.flux = r.get<double>();
+            t.radiance = r.get<double>();
+            t.count = r.get<uint64_t>();
+            if (!(t.flux >= 0) || !(t.radiance >= 0) || !std::isfinite(t.flux) || !std::isfinite(t.radiance))
+                throw std::runtime_error("guide: bad map guide totals");
+        }
+    }
+    if (r.pos != bytes.size()) throw std::runtime_error("guide: trailing bytes after the map guide");
+    return s;
+}
+
+std::string encode(const Saved &s) {
+    BinaryWriter w{std::string(kMagic, sizeof kMagic)};
+    w.put(s.resolution);
+    w.put(s.lo);
+    w.put(s.hi);
+    w.put(s.scale);
+    w.put(s.records);
+    w.put(uint32_t(s.voxels.size()));
+    for (const auto &[i, v] : s.voxels) {
+        w.put(i);
+        w.put(v.first);
+        w.put(uint32_t(v.second.size()));
+        for (const auto &[target, t] : v.second) {
+            w.put(target);
+            w.put(t.flux);
+            w.put(t.radiance);
+            w.put(t.count);
+        }
+    }
+    return std::move(w.bytes);
+}
+
+}  // namespace
+
+void MapGuide::load(std::string_view bytes) {
+    const Saved s = decode(bytes);
+    if (s.resolution != grid_.resolution() || !(s.lo == grid_.bounds().lo) || !(s.hi == grid_.bounds().hi))
+        throw std::runtime_error("guide: the map guide covers another grid");
+    for (Voxel &v : voxels_) v = Voxel{};
+    for (const auto &[i, saved] : s.voxels) {
+        Voxel &v = voxels_[i];
+        v.samples = saved.first;
+        for (const auto &[target, t] : saved.second) v.total[target] = {t.flux, t.radiance, t.count};
+    }
+    scale_exponent_ = std::clamp(int(s.scale), -60, 60);
+    records_ = s.records;
+}
+
+std::string MapGuide::merge(std::string_view base, std::span<const std::string> learned) {
+    if (learned.empty()) return std::string(base);
+    Saved b = base.empty() ? Saved{} : decode(base);
+    Saved out = decode(learned.front());
+    const bool have_base = !base.empty();
+    if (have_base && (b.resolution != out.resolution || !(b.lo == out.lo) || !(b.hi == out.hi)))
+        throw std::runtime_error("guide: map guides of different grids");
+    // out = base + Σ (learned - base), summed as Σ learned - (n - 1) base.
+    for (size_t l = 1; l < learned.size(); ++l) {
+        const Saved s = decode(learned[l]);
+        if (s.resolution != out.resolution || !(s.lo == out.lo) || !(s.hi == out.hi))
+            throw std::runtime_error("guide: map guides of different grids");
+        out.records += s.records;
+        for (const auto &[i, v] : s.voxels) {
+            auto &o = out.voxels[i];
+            o.first += v.first;
+            for (const auto &[target, t] : v.second) {
+                Saved::Totals &ot = o.second[target];
+                ot.flux += t.flux;
+                ot.radiance += t.radiance;
+                ot.count += t.count;
+            }
+        }
+    }
+    if (have_base) {
+        const double m = double(learned.size() - 1);
+        out.records -= std::min(out.records, b.records * (learned.size() - 1));
+        for (const auto &[i, v] : b.voxels) {
+            auto &o = out.voxels[i];
+            o.first -= std::min(o.first, v.first * (learned.size() - 1));
+            for (const auto &[target, t] : v.second) {
+                Saved::Totals &ot = o.second[target];
+                ot.flux = std::max(0.0, ot.flux - m * t.flux);
+                ot.radiance = std::max(0.0, ot.radiance - m * t.radiance);
+                ot.count -= std::min(ot.count, t.count * (learned.size() - 1));
+            }
+        }
+    }
+    return encode(out);
+}
+
+}  // namespace neepp
