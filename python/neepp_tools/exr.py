@@ -5,17 +5,23 @@ LLVM backend), falling back to the ``OpenEXR`` pip package when Mitsuba is not i
 """
 from __future__ import annotations
 
+import threading
 from pathlib import Path
 
 import numpy as np
 
+_import_lock = threading.Lock()
+
 
 def _mitsuba():
-    try:
-        import mitsuba as mi
-    except ImportError:
-        return None
-    return mi
+    # One import at a time: a second thread importing mitsuba while the first is still in it sees the module
+    # half made (no Bitmap yet), as bench scripts rendering with --jobs 2 did.
+    with _import_lock:
+        try:
+            import mitsuba as mi
+        except ImportError:
+            return None
+        return mi
 
 
 def read_exr(path) -> np.ndarray:

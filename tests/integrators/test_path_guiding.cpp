@@ -326,7 +326,7 @@ TEST(MapGuiding, UnbiasedWithAWrongGuide) {
     const uint32_t below = grid.voxel_of(Vec3(0.3f, -0.01f, -0.2f));
     for (int i = 0; i < 200000; ++i) {
         const Vec3 p = grid.bounds().lo + grid.bounds().extent() * Vec3(rng.next_float(), rng.next_float(), rng.next_float());
-        wrong.record(p, below, 1.0, 1.0);
+        wrong.record(p, below, 1.0, 1.0, Vec3(0.3f, -0.01f, -0.2f));
     }
     wrong.update(nullptr);
     OptionMap guided = kMapGuided;

@@ -36,18 +36,58 @@ float bin_density(const Vec3 &d) {
 
 MapGuide::MapGuide(const VoxelGrid &grid, MapGuideOptions options)
     : grid_(grid), options_(options), cell_size_(grid.bounds().extent() / float(grid.resolution())),
-      voxels_(grid.voxel_count()), locks_(new std::mutex[kStripes]) {}
+      voxels_(grid.voxel_count()), locks_(new std::mutex[kStripes]), bound_locks_(new std::mutex[kStripes]),
+      seen_(grid.voxel_count()) {
+    set_boxes();
+}
 
-void MapGuide::record(const Vec3 &p, uint32_t target, double flux, double radiance) {
+void MapGuide::record(const Vec3 &p, uint32_t target, double flux, double radiance, const Vec3 &end) {
     const uint32_t i = grid_.voxel_of(p);
-    Voxel &v = voxels_[i];
-    std::lock_guard<std::mutex> lock(locks_[i % kStripes]);
-    ++v.pass_samples;
-    if (target == kNoTarget || target >= grid_.cell_count()) return;
-    Acc &a = v.pass[target];
-    a.flux += fixed(flux, scale_exponent_);
-    a.radiance += fixed(radiance, scale_exponent_);
-    ++a.count;
+    {
+        Voxel &v = voxels_[i];
+        std::lock_guard<std::mutex> lock(locks_[i % kStripes]);
+        ++v.pass_samples;
+        if (target == kNoTarget || target >= grid_.cell_count()) return;
+        Acc &a = v.pass[target];
+        a.flux += fixed(flux, scale_exponent_);
+        a.radiance += fixed(radiance, scale_exponent_);
+        ++a.count;
+    }
+    // One lock at a time (never the target's while holding the voxel's): no order between them to deadlock.
+    if (!grid_.is_direction_cell(target) && is_finite(end)) {
+        std::lock_guard<std::mutex> lock(bound_locks_[target % kStripes]);
+        seen_[target].expand(end);
+    }
+}
+
+void MapGuide::set_boxes() {
+    boxes_.resize(grid_.voxel_count());
+    inv_volume_.resize(grid_.voxel_count());
+    const Vec3 e = cell_size_;
+    for (uint32_t j = 0; j < grid_.voxel_count(); ++j) {
+        int x, y, z;
+        grid_.voxel_coords(j, x, y, z);
+        BBox voxel;
+        voxel.lo = grid_.bounds().lo + Vec3(float(x), float(y), float(z)) * e;
+        voxel.hi = voxel.lo + e;
+        BBox b = voxel;
+        if (seen_[j].valid()) {
+            b = seen_[j];
+            for (int a = 0; a < 3; ++a) {
+                // At least a twentieth of the voxel thick, moved inside it.
+                const float want = 0.05f * e[a], have = b.hi[a] - b.lo[a];
+                if (have < want) {
+                    b.lo[a] -= 0.5f * (want - have);
+                    b.hi[a] = b.lo[a] + want;
+                }
+                if (b.lo[a] < voxel.lo[a]) b.hi[a] = std::min(voxel.hi[a], b.hi[a] + (voxel.lo[a] - b.lo[a])), b.lo[a] = voxel.lo[a];
+                if (b.hi[a] > voxel.hi[a]) b.lo[a] = std::max(voxel.lo[a], b.lo[a] - (b.hi[a] - voxel.hi[a])), b.hi[a] = voxel.hi[a];
+            }
+        }
+        boxes_[j] = b;
+        const Vec3 ext = b.extent();
+        inv_volume_[j] = float(1.0 / (double(ext.x) * ext.y * ext.z));
+    }
 }
 
 void MapGuide::update(const VisibilityMap *map) {
@@ -69,6 +109,7 @@ void MapGuide::update(const VisibilityMap *map) {
         v.pass_samples = 0;
     }
     records_ += records;
+    set_boxes();
     // The next pass's fixed-point scale: ~2^24 steps below the mean record, a power of two (exact).
     if (records > 0 && flux > 0) {
         const double mean = std::ldexp(double(flux), -scale_exponent_) / double(records);
@@ -168,9 +209,8 @@ Vec3 MapGuide::sample(const Table &t, const Vec3 &p, float u_cell, float u1, Vec
                                        t.cells.size() - 1);
     const uint32_t j = t.cells[at];
     if (grid_.is_direction_cell(j)) return grid_.direction_in_bin(j, u2);
-    int x, y, z;
-    grid_.voxel_coords(j, x, y, z);
-    const Vec3 target = grid_.bounds().lo + Vec3(float(x) + u1, float(y) + u2.x, float(z) + u2.y) * cell_size_;
+    const BBox &b = boxes_[j];
+    const Vec3 target = b.lo + Vec3(u1, u2.x, u2.y) * b.extent();
     const Vec3 d = target - p;
     const float len = norm(d);
     return len > 0 && std::isfinite(len) ? d / len : Vec3(0.f);
@@ -181,8 +221,8 @@ float MapGuide::pdf(const Table &t, const Vec3 &p, const Vec3 &d) const {
 }
 
 // A uniform point of a box of volume V seen from p: along unit d the ray crosses the box over [t0, t1],
-// and the direction's solid-angle density is ∫ t² dt / V = (t1³ - t0³) / 3V. Summed over the voxels the
-// ray from p crosses (a 3D DDA through the grid), each weighted by its pmf.
+// and the direction's solid-angle density is ∫ t² dt / V = (t1³ - t0³) / 3V. Summed over the target boxes
+// of the voxels the ray from p crosses (a 3D DDA through the grid finds them), each weighted by its pmf.
 float MapGuide::voxel_part(const Table &t, const Vec3 &p, const Vec3 &d) const {
     const BBox &b = grid_.bounds();
     float t0 = 0.f, t1 = std::numeric_limits<float>::infinity();
@@ -217,22 +257,33 @@ float MapGuide::voxel_part(const Table &t, const Vec3 &p, const Vec3 &d) const {
         }
     }
     double sum = 0;
-    double tc = t0, tc3 = double(t0) * t0 * t0;
     for (int guard = 0; guard < 3 * n + 3; ++guard) {
         const int a = next[0] < next[1] ? (next[0] < next[2] ? 0 : 2) : (next[1] < next[2] ? 1 : 2);
-        const double tn = std::max(tc, double(std::min(next[a], t1)));
-        const double tn3 = tn * tn * tn;
-        const float pm = t.pmf[uint32_t(ix[0] + n * (ix[1] + n * ix[2]))];
-        if (pm > 0.f) sum += double(pm) * (tn3 - tc3);
-        tc = tn;
-        tc3 = tn3;
-        if (tn >= double(t1)) break;
+        const uint32_t j = uint32_t(ix[0] + n * (ix[1] + n * ix[2]));
+        if (const float pm = t.pmf[j]; pm > 0.f) {
+            // The ray's chord through the voxel's target box (inside the voxel, so within this step).
+            const BBox &box = boxes_[j];
+            float s0 = 0.f, s1 = std::numeric_limits<float>::infinity();
+            for (int k = 0; k < 3; ++k) {
+                if (d[k] != 0.f) {
+                    const float ta = (box.lo[k] - p[k]) / d[k], tb = (box.hi[k] - p[k]) / d[k];
+                    s0 = std::max(s0, std::min(ta, tb));
+                    s1 = std::min(s1, std::max(ta, tb));
+                } else if (p[k] < box.lo[k] || p[k] > box.hi[k]) {
+                    s1 = -1.f;
+                }
+            }
+            if (s0 < s1) {
+                const double a0 = s0, a1 = s1;
+                sum += double(pm) * double(inv_volume_[j]) * (a1 * a1 * a1 - a0 * a0 * a0);
+            }
+        }
+        if (next[a] >= t1) break;
         ix[a] += step[a];
         if (ix[a] < 0 || ix[a] >= n) break;
         next[a] += delta[a];
     }
-    const double volume = double(cell_size_.x) * cell_size_.y * cell_size_.z;
-    return float(sum / (3.0 * volume));
+    return float(sum / 3.0);
 }
 
 nlohmann::json MapGuide::statistics() const {
@@ -272,6 +323,15 @@ std::string MapGuide::save() const {
             w.put(uint64_t(t.count));
         }
     }
+    uint32_t bounded = 0;
+    for (const BBox &b : seen_) bounded += b.valid() ? 1 : 0;
+    w.put(bounded);
+    for (uint32_t j = 0; j < seen_.size(); ++j)
+        if (seen_[j].valid()) {
+            w.put(j);
+            w.put(seen_[j].lo);
+            w.put(seen_[j].hi);
+        }
     return std::move(w.bytes);
 }
 
@@ -288,6 +348,7 @@ struct Saved {
         uint64_t count = 0;
     };
     std::map<uint32_t, std::pair<uint64_t, std::map<uint32_t, Totals>>> voxels;
+    std::map<uint32_t, BBox> seen;  // voxel -> bounds of the end points recorded in it
 };
 
 Saved decode(std::string_view bytes) {
@@ -323,6 +384,17 @@ Saved decode(std::string_view bytes) {
                 throw std::runtime_error("guide: bad map guide totals");
         }
     }
+    const uint32_t bounded = r.get<uint32_t>();
+    if (bounded > voxels) throw std::runtime_error("guide: bad map guide size");
+    for (uint32_t u = 0; u < bounded; ++u) {
+        const uint32_t j = r.get<uint32_t>();
+        BBox b;
+        b.lo = r.get<Vec3>();
+        b.hi = r.get<Vec3>();
+        if (j >= voxels || s.seen.count(j) || !b.valid() || !is_finite(b.lo) || !is_finite(b.hi))
+            throw std::runtime_error("guide: bad map guide bounds");
+        s.seen[j] = b;
+    }
     if (r.pos != bytes.size()) throw std::runtime_error("guide: trailing bytes after the map guide");
     return s;
 }
@@ -346,6 +418,12 @@ std::string encode(const Saved &s) {
             w.put(t.count);
         }
     }
+    w.put(uint32_t(s.seen.size()));
+    for (const auto &[j, b] : s.seen) {
+        w.put(j);
+        w.put(b.lo);
+        w.put(b.hi);
+    }
     return std::move(w.bytes);
 }
 
@@ -361,6 +439,9 @@ void MapGuide::load(std::string_view bytes) {
         v.samples = saved.first;
         for (const auto &[target, t] : saved.second) v.total[target] = {t.flux, t.radiance, t.count};
     }
+    for (BBox &b : seen_) b = BBox{};
+    for (const auto &[j, b] : s.seen) seen_[j] = b;
+    set_boxes();
     scale_exponent_ = std::clamp(int(s.scale), -60, 60);
     records_ = s.records;
 }
@@ -378,6 +459,7 @@ std::string MapGuide::merge(std::string_view base, std::span<const std::string> 
         if (s.resolution != out.resolution || !(s.lo == out.lo) || !(s.hi == out.hi))
             throw std::runtime_error("guide: map guides of different grids");
         out.records += s.records;
+        for (const auto &[j, bounds] : s.seen) out.seen[j].expand(bounds);  // a union: the base's are in each
         for (const auto &[i, v] : s.voxels) {
             auto &o = out.voxels[i];
             o.first += v.first;

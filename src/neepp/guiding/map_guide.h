@@ -6,7 +6,9 @@
 //
 // p(j | i) ∝ the flux arriving at voxel i from cell j, learned from the paths: each guided vertex's record
 // is the radiance its direction brought back over the direction's density, filed under (i, the cell where
-// the direction's ray ended). Where voxel i has few records, the map supplies a prior: Ṽ(i, j) × the mean
+// the direction's ray ended). A voxel target is sampled in the box of the end points recorded in it (at
+// least a twentieth of the voxel thick), not in the whole voxel: a floor's voxel is then a slab on the
+// floor, and its directions go to the floor rather than past it. Where voxel i has few records, the map supplies a prior: Ṽ(i, j) × the mean
 // radiance that cell j sent along every recorded ray that ended there × j's solid angle from i, blended
 // with the learned flux as k pseudo-records would be. The learned sums grow over every pass (each record
 // is an unbiased estimate, whatever guide drew it), so the guide sharpens as the render goes on.
@@ -25,6 +27,7 @@
 #include <unordered_map>
 #include <vector>
 #include <nlohmann/json.hpp>
+#include "neepp/math/bbox.h"
 #include "neepp/math/vec.h"
 #include "neepp/visibility/voxel_grid.h"
 
@@ -65,10 +68,14 @@ public:
         return grid_.cell_of_end(end, d, escaped);
     }
     static constexpr uint32_t kNoTarget = 0xffffffffu;
-    // A record from a vertex at p whose direction's ray ended in cell `target` (kNoTarget: unknown, e.g.
-    // the path stopped; it still counts as one of the voxel's samples): `flux` = the radiance that arrived
-    // over the direction's density, `radiance` = what arrived. Thread-safe; sums are order-independent.
-    void record(const Vec3 &p, uint32_t target, double flux, double radiance);
+    // A record from a vertex at p whose direction's ray ended at `end` in cell `target` (kNoTarget:
+    // unknown, e.g. the path stopped; it still counts as one of the voxel's samples; `end` is read for voxel
+    // targets only): `flux` = the radiance that arrived over the direction's density, `radiance` = what
+    // arrived. Thread-safe; sums (and the end points' bounds) are order-independent.
+    void record(const Vec3 &p, uint32_t target, double flux, double radiance, const Vec3 &end);
+    // Where the coming pass samples voxel target j (a box within the voxel; the voxel's own box before any
+    // end point was recorded in it).
+    const BBox &target_box(uint32_t voxel) const { return boxes_[voxel]; }
 
     // Between passes, single-threaded: the pass's records join the totals and the tables are rebuilt,
     // the prior reading `map` (null: no prior, the records alone).
@@ -102,13 +109,17 @@ private:
     };
     static constexpr int kStripes = 64;
     void build_tables(const VisibilityMap *map);
+    void set_boxes();  // boxes_ from seen_
     float voxel_part(const Table &t, const Vec3 &p, const Vec3 &d) const;
 
     VoxelGrid grid_;
     MapGuideOptions options_;
     Vec3 cell_size_;
     std::vector<Voxel> voxels_;
-    std::unique_ptr<std::mutex[]> locks_;
+    std::unique_ptr<std::mutex[]> locks_, bound_locks_;
+    std::vector<BBox> seen_;   // per voxel: the bounds of the end points recorded in it, all passes
+    std::vector<BBox> boxes_;  // per voxel: where the coming pass samples it as a target
+    std::vector<float> inv_volume_;  // of boxes_
     int scale_exponent_ = 20;  // a record's fixed-point value is value · 2^scale_exponent_
     double pass_flux_ = 0;     // what the last pass recorded (to set the next exponent)
     uint64_t pass_records_ = 0, records_ = 0;

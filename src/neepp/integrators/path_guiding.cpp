@@ -89,7 +89,7 @@ void GuideRecorder::commit(MapGuide &map, const Color &L) const {
         const Vertex &v = v_[i];
         const uint32_t target = v.end_kind == kOpen ? MapGuide::kNoTarget : map.target_of(v.end, v.d, v.end_kind == kEscaped);
         const double arrived = v.arrived(L);
-        map.record(v.p, target, arrived / double(v.pdf), arrived);
+        map.record(v.p, target, arrived / double(v.pdf), arrived, v.end);
     }
 }
 
