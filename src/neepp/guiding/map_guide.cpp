@@ -176,7 +176,11 @@ void MapGuide::build_tables(const VisibilityMap *map) {
                     const double d2 = double(squared_norm(center(j) - ci));
                     solid_angle = d2 > 0 ? std::min(2.0 * M_PI, mean_area / d2) : 2.0 * M_PI;
                 }
-                w[j] += k * double(map->estimate(i, j)) * radiance[j] * solid_angle / (n + k);
+                // Pairs the map has traced only: its 1/2 for an unknown pair would send the prior to every
+                // bright voxel behind every wall.
+                const PairCounts c = map->counts(i, j);
+                if (c.traced == 0) continue;
+                w[j] += k * double(VisibilityMap::estimate(c)) * radiance[j] * solid_angle / (n + k);
             }
         }
         double sum = 0;
