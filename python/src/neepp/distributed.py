@@ -439,7 +439,10 @@ def main(argv=None) -> int:
     try:
         return _render_and_write(a, params, pairs(a.I, "-I"), checkpoint, png, write_images, stopped_by, rendered)
     finally:
-        signal.signal(signal.SIGTERM, previous)
+        # Once rendered, the handler stays through the exit that follows (Ray's disconnect at interpreter exit
+        # takes a while): a SIGTERM then must not kill a process whose image is written (exit -15).
+        if not rendered:
+            signal.signal(signal.SIGTERM, previous)
 
 
 def _render_and_write(a, params, options, checkpoint, png, write_images, stopped_by, rendered):
