@@ -42,12 +42,13 @@ cmake -S "$ROOT" -B "$B" -G Ninja -DCMAKE_CXX_COMPILER=clang++ -DCMAKE_BUILD_TYP
   -DNEEPP_PGO= -DNEEPP_MARCH=x86-64-v3 -DNEEPP_SANITIZE=thread \
   -DCMAKE_PREFIX_PATH="$B/tbb" >/dev/null
 # test_display: TevDisplay's sending thread (--display-server) and the render's hand-over to it.
-cmake --build "$B" --target test_render test_visibility test_display -j"$(nproc)"
+# test_guiding: the SD-tree's and the map guide's records arrive from four threads at once.
+cmake --build "$B" --target test_render test_visibility test_display test_guiding -j"$(nproc)"
 export TSAN_OPTIONS="halt_on_error=1 second_deadlock_stack=1 suppressions=$ROOT/tests/sanitizers/tsan.supp"
-for t in test_render test_visibility test_display; do
-  if [[ $t != test_display ]]; then  # the display uses no TBB
+for t in test_render test_visibility test_display test_guiding; do
+  if [[ $t == test_render || $t == test_visibility ]]; then  # the display and the guides' tests use no TBB
     [[ "$(ldd "$B/$t")" == *"$B/tbb/lib/libtbb"* ]] || { echo "test_tsan: $t does not use the instrumented TBB"; exit 1; }
   fi
   "$B/$t" --gtest_brief=1
 done
-echo "test_tsan: no data race in the render loop's (concurrent renders included), the visibility map's or the display's tests"
+echo "test_tsan: no data race in the render loop's (concurrent renders included), the visibility map's, the display's or the guides' tests"
