@@ -32,6 +32,22 @@ float bin_density(const Vec3 &d) {
     return m > 0 ? (S * 0.5f) * (S * 0.5f) / (m * m * m) : 0.f;
 }
 
+// Where the ray p + t·d, t >= 0, crosses the box: [t0, t1], false if it misses it.
+bool chord(const BBox &b, const Vec3 &p, const Vec3 &d, float &t0, float &t1) {
+    t0 = 0.f;
+    t1 = std::numeric_limits<float>::infinity();
+    for (int a = 0; a < 3; ++a) {
+        if (d[a] != 0.f) {
+            const float ta = (b.lo[a] - p[a]) / d[a], tb = (b.hi[a] - p[a]) / d[a];
+            t0 = std::max(t0, std::min(ta, tb));
+            t1 = std::min(t1, std::max(ta, tb));
+        } else if (p[a] < b.lo[a] || p[a] > b.hi[a]) {
+            return false;
+        }
+    }
+    return t0 < t1;
+}
+
 }  // namespace
 
 MapGuide::MapGuide(const VoxelGrid &grid, MapGuideOptions options)
@@ -229,17 +245,8 @@ float MapGuide::pdf(const Table &t, const Vec3 &p, const Vec3 &d) const {
 // of the voxels the ray from p crosses (a 3D DDA through the grid finds them), each weighted by its pmf.
 float MapGuide::voxel_part(const Table &t, const Vec3 &p, const Vec3 &d) const {
     const BBox &b = grid_.bounds();
-    float t0 = 0.f, t1 = std::numeric_limits<float>::infinity();
-    for (int a = 0; a < 3; ++a) {
-        if (d[a] != 0.f) {
-            const float ta = (b.lo[a] - p[a]) / d[a], tb = (b.hi[a] - p[a]) / d[a];
-            t0 = std::max(t0, std::min(ta, tb));
-            t1 = std::min(t1, std::max(ta, tb));
-        } else if (p[a] < b.lo[a] || p[a] > b.hi[a]) {
-            return 0.f;
-        }
-    }
-    if (!(t0 < t1)) return 0.f;
+    float t0, t1;
+    if (!chord(b, p, d, t0, t1)) return 0.f;
     const int n = grid_.resolution();
     int ix[3], step[3];
     float next[3], delta[3];
@@ -266,18 +273,7 @@ float MapGuide::voxel_part(const Table &t, const Vec3 &p, const Vec3 &d) const {
         const uint32_t j = uint32_t(ix[0] + n * (ix[1] + n * ix[2]));
         if (const float pm = t.pmf[j]; pm > 0.f) {
             // The ray's chord through the voxel's target box (inside the voxel, so within this step).
-            const BBox &box = boxes_[j];
-            float s0 = 0.f, s1 = std::numeric_limits<float>::infinity();
-            for (int k = 0; k < 3; ++k) {
-                if (d[k] != 0.f) {
-                    const float ta = (box.lo[k] - p[k]) / d[k], tb = (box.hi[k] - p[k]) / d[k];
-                    s0 = std::max(s0, std::min(ta, tb));
-                    s1 = std::min(s1, std::max(ta, tb));
-                } else if (p[k] < box.lo[k] || p[k] > box.hi[k]) {
-                    s1 = -1.f;
-                }
-            }
-            if (s0 < s1) {
+            if (float s0, s1; chord(boxes_[j], p, d, s0, s1)) {
                 const double a0 = s0, a1 = s1;
                 sum += double(pm) * double(inv_volume_[j]) * (a1 * a1 * a1 - a0 * a0 * a0);
             }
@@ -297,46 +293,6 @@ nlohmann::json MapGuide::statistics() const {
             {"tables", tables_.size()},
             {"targets_mean", tables_.empty() ? 0.0 : double(targets) / double(tables_.size())},
             {"records", records_}};
-}
-
-// Totals in ascending (voxel, target) order, so that equal guides save equal bytes.
-std::string MapGuide::save() const {
-    BinaryWriter w{std::string(kMagic, sizeof kMagic)};
-    w.put(int32_t(grid_.resolution()));
-    w.put(grid_.bounds().lo);
-    w.put(grid_.bounds().hi);
-    w.put(int32_t(scale_exponent_));
-    w.put(uint64_t(records_));
-    uint32_t used = 0;
-    for (const Voxel &v : voxels_) used += v.samples > 0 ? 1 : 0;
-    w.put(used);
-    for (uint32_t i = 0; i < voxels_.size(); ++i) {
-        const Voxel &v = voxels_[i];
-        if (v.samples == 0) continue;
-        w.put(i);
-        w.put(uint64_t(v.samples));
-        std::vector<uint32_t> targets;
-        for (const auto &[target, t] : v.total) targets.push_back(target);
-        std::sort(targets.begin(), targets.end());
-        w.put(uint32_t(targets.size()));
-        for (uint32_t target : targets) {
-            const Total &t = v.total.at(target);
-            w.put(target);
-            w.put(t.flux);
-            w.put(t.radiance);
-            w.put(uint64_t(t.count));
-        }
-    }
-    uint32_t bounded = 0;
-    for (const BBox &b : seen_) bounded += b.valid() ? 1 : 0;
-    w.put(bounded);
-    for (uint32_t j = 0; j < seen_.size(); ++j)
-        if (seen_[j].valid()) {
-            w.put(j);
-            w.put(seen_[j].lo);
-            w.put(seen_[j].hi);
-        }
-    return std::move(w.bytes);
 }
 
 namespace {
@@ -403,6 +359,8 @@ Saved decode(std::string_view bytes) {
     return s;
 }
 
+bool same_grid(const Saved &a, const Saved &b) { return a.resolution == b.resolution && a.lo == b.lo && a.hi == b.hi; }
+
 std::string encode(const Saved &s) {
     BinaryWriter w{std::string(kMagic, sizeof kMagic)};
     w.put(s.resolution);
@@ -433,10 +391,33 @@ std::string encode(const Saved &s) {
 
 }  // namespace
 
+// In ascending (voxel, target) order (Saved's maps), so that equal guides save equal bytes.
+std::string MapGuide::save() const {
+    Saved s;
+    s.resolution = grid_.resolution();
+    s.lo = grid_.bounds().lo;
+    s.hi = grid_.bounds().hi;
+    s.scale = scale_exponent_;
+    s.records = records_;
+    for (uint32_t i = 0; i < voxels_.size(); ++i) {
+        const Voxel &v = voxels_[i];
+        if (v.samples == 0) continue;
+        auto &[samples, targets] = s.voxels[i];
+        samples = v.samples;
+        for (const auto &[target, t] : v.total) targets[target] = {t.flux, t.radiance, t.count};
+    }
+    for (uint32_t j = 0; j < seen_.size(); ++j)
+        if (seen_[j].valid()) s.seen[j] = seen_[j];
+    return encode(s);
+}
+
 void MapGuide::load(std::string_view bytes) {
     const Saved s = decode(bytes);
-    if (s.resolution != grid_.resolution() || !(s.lo == grid_.bounds().lo) || !(s.hi == grid_.bounds().hi))
-        throw std::runtime_error("guide: the map guide covers another grid");
+    Saved mine;
+    mine.resolution = grid_.resolution();
+    mine.lo = grid_.bounds().lo;
+    mine.hi = grid_.bounds().hi;
+    if (!same_grid(s, mine)) throw std::runtime_error("guide: the map guide covers another grid");
     for (Voxel &v : voxels_) v = Voxel{};
     for (const auto &[i, saved] : s.voxels) {
         Voxel &v = voxels_[i];
@@ -455,13 +436,11 @@ std::string MapGuide::merge(std::string_view base, std::span<const std::string> 
     Saved b = base.empty() ? Saved{} : decode(base);
     Saved out = decode(learned.front());
     const bool have_base = !base.empty();
-    if (have_base && (b.resolution != out.resolution || !(b.lo == out.lo) || !(b.hi == out.hi)))
-        throw std::runtime_error("guide: map guides of different grids");
+    if (have_base && !same_grid(b, out)) throw std::runtime_error("guide: map guides of different grids");
     // out = base + Σ (learned - base), summed as Σ learned - (n - 1) base.
     for (size_t l = 1; l < learned.size(); ++l) {
         const Saved s = decode(learned[l]);
-        if (s.resolution != out.resolution || !(s.lo == out.lo) || !(s.hi == out.hi))
-            throw std::runtime_error("guide: map guides of different grids");
+        if (!same_grid(s, out)) throw std::runtime_error("guide: map guides of different grids");
         out.records += s.records;
         for (const auto &[j, bounds] : s.seen) out.seen[j].expand(bounds);  // a union: the base's are in each
         for (const auto &[i, v] : s.voxels) {
