@@ -111,6 +111,7 @@ const std::vector<OptionMap> kOptionSets = {
     {{"guiding", "sdtree"}, {"ris", "4"}, {"shadow_rays", "neepp"}},
     {{"guiding", "map"}},
     {{"guiding", "map"}, {"ris", "4"}, {"shadow_rays", "neepp"}},
+    {{"guiding", "sdtree+map"}, {"guiding_tree_share", "0.3"}},
 };
 
 std::string describe(const Family &f, const OptionMap &o) {
@@ -240,6 +241,7 @@ TEST(PathForms, SameImageInExpectation) {
         {6, {{"area_light_sampling", "solid-angle"}}}, {0, {{"area_light_sampling", "solid-angle"}}},
         {0, {{"guiding", "sdtree"}}}, {5, {{"guiding", "sdtree"}, {"guiding_bsdf_fraction", "0.3"}, {"guiding_learn_direct", "false"}}},
         {0, {{"guiding", "map"}}}, {5, {{"guiding", "map"}, {"guiding_bsdf_fraction", "0.3"}, {"guiding_learn_direct", "false"}}},
+        {5, {{"guiding", "sdtree+map"}}},
     };
     for (auto [family, o] : cases) {
         const std::string what = describe(kFamilies[family], o);

@@ -1,4 +1,4 @@
-// Path guiding in the path integrator (guiding=sdtree and guiding=map): the guided image against plain NEE's
+// Path guiding in the path integrator (guiding=sdtree, map and sdtree+map): the guided image against plain NEE's
 // (per-block z-tests), with the guide learning as it renders and with guides that are deliberately wrong
 // for the scene, which must cost variance only; images the same to the bit for a seed and thread count;
 // the option accepted where it is implemented and refused elsewhere.
@@ -397,5 +397,158 @@ TEST(MapGuiding, StateCarriesAndMergesTheTotals) {
     EXPECT_THROW(fresh->restore_state(*scene, tree->save_state()), std::runtime_error);
 }
 
+
+
+// Both guides (guiding=sdtree+map): three strategies of the one-sample MIS. Each guide's sampling is
+// chi-square tested against its density on its own (above, and tests/guiding/test_map_guide.cpp); here the
+// mixture: u_pick below the tree's share draws the tree's direction for (u1, u2), above it the map guide's
+// for u_pick rescaled, and the density is the two weighed by their shares, integrating to one.
+const OptionMap kBothGuided = {{"guiding", "sdtree+map"}};
+
+TEST(BothGuides, TheMixtureDrawsEachGuideByItsShare) {
+    // A vertex on the lit room's floor (diffuse), and both guides learned at it.
+    auto scene = load_scene(write_temp_scene(lit_room_xml()));
+    SurfaceInteraction si;
+    ASSERT_TRUE(scene->intersect(Ray{Vec3(0.1f, 1.f, 0.05f), Vec3(0, -1, 0)}, si));
+    const Vec3 p = si.p;
+    BBox box;
+    box.expand(Vec3(-1.f));
+    box.expand(Vec3(1.f));
+    SDTreeOptions o;
+    o.max_depth = 7;
+    SDTree tree(box, o);
+    const VoxelGrid grid(box, 4);
+    MapGuide map(grid);
+    PCG32 rng(3, 3);
+    const Vec3 lamp(0.6f, 0.9f, -0.7f), corner(-0.9f, 0.9f, 0.9f);
+    for (int pass = 0; pass < 2; ++pass) {
+        for (int i = 0; i < 30000; ++i) {
+            Vec3 d(2 * rng.next_float() - 1, 2 * rng.next_float() - 1, 2 * rng.next_float() - 1);
+            if (rng.next_float() < 0.6f) d = Vec3(0.3f, 0.8f, -0.2f) + d * 0.2f;
+            tree.record(p, d / norm(d), 1.0);
+            map.record(p, grid.voxel_of(lamp), 2.0, 1.0, lamp);
+            if (i % 3 == 0) map.record(p, grid.voxel_of(corner), 1.0, 1.0, corner);
+        }
+        tree.update(1);
+        map.update(nullptr);
+    }
+    const float share = 0.3f;
+    const VertexGuide g = guide_at(&tree, &map, true, si, 0.5f, share);
+    ASSERT_TRUE(g.tree && g.table) << "both guide here";
+    EXPECT_FLOAT_EQ(g.tree_share, share);
+    const VertexGuide tree_only = guide_at(&tree, nullptr, true, si, 0.5f, share);
+    const VertexGuide map_only = guide_at(nullptr, &map, true, si, 0.5f, share);
+    EXPECT_TRUE(tree_only.tree && !tree_only.table && tree_only.tree_share == 1.f);
+    EXPECT_TRUE(!map_only.tree && map_only.table && map_only.tree_share == 0.f);
+    EXPECT_FALSE(guide_at(&tree, &map, true, si, 0.5f, 0.f).tree) << "a share of 0: the map's guide alone";
+    EXPECT_FALSE(guide_at(&tree, &map, true, si, 0.5f, 1.f).table) << "a share of 1: the tree alone";
+    PCG32 r(4, 4);
+    int from_tree = 0;
+    for (int i = 0; i < 2000; ++i) {
+        const float u_pick = r.next_float(), u1 = r.next_float();
+        const Vec2 u2 = r.next_2d();
+        const Vec3 d = g.raw_sample(u_pick, u1, u2);
+        if (u_pick < share) {
+            ++from_tree;
+            EXPECT_EQ(d, tree_only.raw_sample(0.f, u1, u2));
+        } else {
+            EXPECT_EQ(d, map_only.raw_sample(std::min((u_pick - share) / (1.f - share), kOneMinusEpsilon), u1, u2));
+        }
+        const Vec3 e = r.next_float() < 0.5f ? d : Vec3(r.next_float() - 0.5f, r.next_float() - 0.5f, r.next_float() - 0.5f);
+        const Vec3 dir = e / norm(e);
+        EXPECT_NEAR(g.raw_pdf(dir), share * tree_only.raw_pdf(dir) + (1 - share) * map_only.raw_pdf(dir),
+                    1e-5f * (1 + g.raw_pdf(dir)));
+    }
+    EXPECT_GT(from_tree, 500);
+    // The mixture's density integrates to one over the sphere (a 512 x 512 grid of equal solid angle; the map
+    // guide's box densities are not aligned to it, hence the tolerance).
+    double integral = 0;
+    const int n = 512;
+    for (int y = 0; y < n; ++y)
+        for (int x = 0; x < n; ++x) {
+            const double phi = 6.283185307179586 * (y + 0.5) / n, ct = 2 * (x + 0.5) / n - 1, st = std::sqrt(1 - ct * ct);
+            integral += double(g.raw_pdf(Vec3(float(st * std::cos(phi)), float(st * std::sin(phi)), float(ct))));
+        }
+    EXPECT_NEAR(integral * 4 * 3.141592653589793 / (double(n) * n), 1.0, 0.02);
+}
+
+TEST(BothGuides, OptionKeepsBothAndEachLearns) {
+    auto scene = load_scene(write_temp_scene(lit_room_xml()));
+    auto integrator = make_integrator("path", with_scene_options(*scene, Options(kBothGuided)));
+    EXPECT_EQ(integrator->describe()["guiding"], "sdtree+map");
+    RenderJob job;
+    job.spp = 16;
+    job.seed = 3;
+    render(*scene, *integrator, job);
+    const auto &pi = dynamic_cast<const PathIntegrator &>(*integrator);
+    ASSERT_NE(pi.guide(), nullptr);
+    ASSERT_NE(pi.map_guide(), nullptr);
+    EXPECT_GT(pi.map_guide()->records(), 1000u);
+    EXPECT_EQ(integrator->statistics()["guiding"]["kind"], "sdtree+map");
+    EXPECT_EQ(integrator->statistics()["guiding"]["map"]["kind"], "map");
+    EXPECT_THROW(make_integrator("path", Options(OptionMap{{"guiding", "sdtree+map"}, {"guiding_tree_share", "1.5"}})),
+                 std::invalid_argument);
+    EXPECT_THROW(make_integrator("path", Options(OptionMap{{"guiding", "sdtree+mop"}})), std::invalid_argument);
+}
+
+// As MapGuiding.UnbiasedAgainstPlainNee, with the two guides sharing the guided directions (a quarter or
+// most of them to the tree).
+TEST(BothGuides, UnbiasedAgainstPlainNee) {
+    const std::vector<std::pair<std::string, std::string>> scenes = {{"lit room", lit_room_xml()},
+                                                                      {"glossy room", kGlossyRoomXml}};
+    for (const auto &[name, xml] : scenes) {
+        const std::string path = write_temp_scene(xml);
+        const BlockMoments nee = block_moments(path, "path", Options(), 6, 64, 101);
+        expect_same_image(nee, guided_moments(path, kBothGuided, 6, 64, 717, nullptr), name + " both guides");
+        OptionMap mostly_guide = kBothGuided;
+        mostly_guide["guiding_bsdf_fraction"] = "0.25";
+        mostly_guide["guiding_tree_share"] = "0.75";
+        mostly_guide["shadow_rays"] = "neepp";
+        expect_same_image(nee, guided_moments(path, mostly_guide, 12, 64, 767, nullptr),
+                          name + " both guides, bsdf_fraction 0.25, tree share 0.75, NEE++ shadow rays");
+    }
+}
+
+TEST(BothGuides, SameImageToTheBitAndStateCarriesBoth) {
+    const std::string path = write_temp_scene(lit_room_xml());
+    auto scene = load_scene(path);
+    auto render_once = [&](uint64_t seed, const char *form, std::string *state) {
+        OptionMap o = kBothGuided;
+        o["form"] = form;
+        auto integrator = make_integrator("path", with_scene_options(*scene, Options(o)));
+        RenderJob job;
+        job.spp = 16;
+        job.seed = seed;
+        job.threads = 4;
+        Image image = render(*scene, *integrator, job).image;
+        if (state) *state = integrator->save_state();
+        return image;
+    };
+    for (const char *form : {"fast", "reference"}) {
+        const Image a = render_once(9, form, nullptr), b = render_once(9, form, nullptr);
+        EXPECT_TRUE(a.data == b.data) << form << ": the same seed and thread count";
+    }
+    std::string state_a, state_b;
+    render_once(1, "fast", &state_a);
+    render_once(2, "fast", &state_b);
+    auto fresh = make_integrator("path", with_scene_options(*scene, Options(kBothGuided)));
+    fresh->prepare(*scene);
+    fresh->restore_state(*scene, state_a);
+    EXPECT_EQ(fresh->save_state(), state_a) << "the tree and the map guide's totals both come back";
+    fresh->restore_state(*scene, fresh->merge_states(std::string(), {state_a, state_b}));
+    const auto &pi = dynamic_cast<const PathIntegrator &>(*fresh);
+    auto guides_of = [&](const std::string &state) {
+        auto one = make_integrator("path", with_scene_options(*scene, Options(kBothGuided)));
+        one->prepare(*scene);
+        one->restore_state(*scene, state);
+        const auto &p = dynamic_cast<const PathIntegrator &>(*one);
+        return std::pair{*p.guide(), p.map_guide()->records()};
+    };
+    const auto [tree_a, records_a] = guides_of(state_a);
+    const auto [tree_b, records_b] = guides_of(state_b);
+    const SDTree *trees[] = {&tree_a, &tree_b};
+    EXPECT_TRUE(*pi.guide() == SDTree::merge(trees));
+    EXPECT_EQ(pi.map_guide()->records(), records_a + records_b);
+}
 
 }  // namespace

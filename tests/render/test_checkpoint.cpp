@@ -75,6 +75,7 @@ TEST(Checkpoint, GuidedPathResumesToTheSameImage) {
     expect_resume_is_exact("path", {{"guiding", "sdtree"}}, 6, 10);
     expect_resume_is_exact("path", {{"guiding", "sdtree"}, {"shadow_rays", "neepp"}}, 6, 10);
     expect_resume_is_exact("path", {{"guiding", "map"}}, 6, 10);
+    expect_resume_is_exact("path", {{"guiding", "sdtree+map"}}, 6, 10);
 }
 
 TEST(Checkpoint, VisibilityAwareLightSelectionResumesToTheSameImage) {

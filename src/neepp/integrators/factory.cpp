@@ -115,8 +115,11 @@ std::unique_ptr<PathIntegrator> make_path(const Options &options, bool volumetri
     o.reference = form == "reference";
     if (!volumetric) {
         o.guiding = options.get_string("guiding", "none");
-        if (o.guiding != "none" && o.guiding != "sdtree" && o.guiding != "map")
-            throw std::invalid_argument("guiding must be 'none', 'sdtree' or 'map', not '" + o.guiding + "'");
+        if (o.guiding != "none" && o.guiding != "sdtree" && o.guiding != "map" && o.guiding != "sdtree+map")
+            throw std::invalid_argument("guiding must be 'none', 'sdtree', 'map' or 'sdtree+map', not '" + o.guiding + "'");
+        o.guiding_tree_share = options.get_float("guiding_tree_share", o.guiding_tree_share);
+        if (!(o.guiding_tree_share >= 0.f && o.guiding_tree_share <= 1.f))
+            throw std::invalid_argument("guiding_tree_share must be in [0, 1]");
         o.guiding_bsdf_fraction = options.get_float("guiding_bsdf_fraction", o.guiding_bsdf_fraction);
         if (!(o.guiding_bsdf_fraction > 0.f && o.guiding_bsdf_fraction <= 1.f))
             throw std::invalid_argument("guiding_bsdf_fraction must be in (0, 1]: the BSDF's share keeps guiding unbiased");
@@ -145,7 +148,7 @@ std::unique_ptr<PathIntegrator> make_path(const Options &options, bool volumetri
     }
     // Resampling reads the map whatever the light sampler: its target holds Ṽ.
     const bool needs_map = light_sampler_needs_visibility_map(o.light_sampler) || o.within_light != "own" || o.ris > 1 ||
-                           o.guiding == "map";
+                           o.guides_by_map();
     if (o.light_sampler.rfind("spatial", 0) == 0 || o.light_sampler.rfind("bayes", 0) == 0 || needs_map || options.get_string("shadow_rays", "nee") != "nee")
         o.voxels = options.get_int("voxels", o.voxels);
     // A light sampler reading the map needs it from the first pass: no deferred seeding then.

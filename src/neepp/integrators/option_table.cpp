@@ -63,10 +63,14 @@ std::vector<IntegratorDoc> make_docs() {
                             "each pass's paths guides the next direction by one-sample MIS with the BSDF "
                             "where the BSDF has no delta part; map: the visibility map's guide, toward the grid's "
                             "cells by the flux each voxel learned from them, the map's visibility as the prior "
-                            "(docs/neepp.md); unbiased whatever either learned", ""});
+                            "(docs/neepp.md); sdtree+map: both, as a third strategy; unbiased whatever any "
+                            "learned", ""});
     path.options.push_back({"guiding_bsdf_fraction", text(p.guiding_bsdf_fraction),
                             "guiding: the share of next directions the BSDF samples (the rest the guide), "
                             "in (0, 1]", ""});
+    path.options.push_back({"guiding_tree_share", text(p.guiding_tree_share),
+                            "guiding=sdtree+map: the SD-tree's share of the guide's directions where both guide "
+                            "(the rest the map's guide), in [0, 1]", ""});
     path.options.push_back({"guiding_spatial_threshold", text(float(p.guiding_spatial_threshold)),
                             "guiding=sdtree: c, a spatial leaf of the SD-tree splits past c * sqrt(pass spp) "
                             "records (0: PPG's 12000 scaled by sqrt(pixels / 1280x720))", ""});

@@ -36,7 +36,7 @@ void PathIntegrator::prepare(const Scene &scene) {
     // a map that no shadow-ray policy uses either is not built. Resampling reads it on any scene.
     if (shadow_->policy() == "nee" && shadow_->visibility_map() &&
         !light_sampler_needs_visibility_map(options_.light_sampler, scene.lights().size()) &&
-        options_.within_light == "own" && !resampling() && options_.guiding != "map")
+        options_.within_light == "own" && !resampling() && !options_.guides_by_map())
         shadow_ = std::make_unique<TraceAllShadowRays>();
     shadow_->prepare(scene);  // NEE++: build or load the visibility map
     queries_ = &shadow_->query_tester();
@@ -46,12 +46,12 @@ void PathIntegrator::prepare(const Scene &scene) {
     within_light_ = WithinLightSampling(options_.within_light, scene, shadow_->voxel_grid(), shadow_->visibility_map(),
                                         options_.area_light_sampling);
     refresh_resampling();
-    if (options_.guiding == "map" && guide_learns_) {
+    if (options_.guides_by_map() && guide_learns_) {
         if (!shadow_->voxel_grid())
             throw std::invalid_argument("guiding=map: the shadow-ray component keeps no visibility map");
         map_guide_ = std::make_unique<MapGuide>(*shadow_->voxel_grid());
     }
-    if (options_.guiding == "sdtree" && guide_learns_) {
+    if (options_.guides_by_tree() && guide_learns_) {
         SDTreeOptions tree;
         // PPG's c = 12000 is for 1280x720 images: a leaf splits past c·√(pass spp) records, and the
         // records of a pass grow with the pixels, so at the same c a smaller image gets fewer leaves.
@@ -85,7 +85,7 @@ void PathIntegrator::end_pass(const Scene &, const PassStatistics &pass) {
 
 VertexGuide PathIntegrator::vertex_guide(const SurfaceInteraction &si) const {
     const float f = options_.guiding_bsdf_fraction;
-    return map_guide_ ? guide_at(map_guide_.get(), guide_learns_, si, f) : guide_at(guide_.get(), guide_learns_, si, f);
+    return guide_at(guide_.get(), map_guide_.get(), guide_learns_, si, f, options_.guiding_tree_share);
 }
 
 void PathIntegrator::commit_guide(const GuideRecorder &recorder, const Color &L) const {
@@ -95,15 +95,15 @@ void PathIntegrator::commit_guide(const GuideRecorder &recorder, const Color &L)
 }
 
 void PathIntegrator::restore_state(const Scene &, const std::string &state) {
-    const PathState parts = PathState::decode(state, framed_state());
+    const PathState parts = PathState::decode(state, framed_state(), options_.guides_by_map());
     shadow_->restore_state(parts.shadow);
     if (learner_ && !parts.light.empty()) learner_->restore_state(parts.light);
     if (guide_ && guide_learns_ && !parts.guide.empty()) {
         guide_->load(parts.guide);
         guide_spp_ = parts.guide_spp;
     }
-    if (map_guide_ && guide_learns_ && !parts.guide.empty()) {
-        map_guide_->load(parts.guide);
+    if (map_guide_ && guide_learns_ && !parts.map_guide.empty()) {
+        map_guide_->load(parts.map_guide);
         map_guide_->update(shadow_->visibility_map());  // tables from the restored totals and map
     }
     queries_ = &shadow_->query_tester();
@@ -121,8 +121,10 @@ nlohmann::json PathIntegrator::statistics() const {
         out["light_sampler"] = l;
     }
     if (within_light_.any()) out["within_light"] = within_light_.statistics();
-    if (guide_) out["guiding"] = guide_->statistics();
-    if (map_guide_) out["guiding"] = map_guide_->statistics();
+    if (guide_ && map_guide_)
+        out["guiding"] = {{"kind", "sdtree+map"}, {"sdtree", guide_->statistics()}, {"map", map_guide_->statistics()}};
+    else if (guide_) out["guiding"] = guide_->statistics();
+    else if (map_guide_) out["guiding"] = map_guide_->statistics();
     return out;
 }
 

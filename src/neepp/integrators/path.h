@@ -41,9 +41,16 @@ struct PathOptions {
     bool volumetric = false;
     // Path guiding (path_guiding.h): at vertices without a delta BSDF part the next direction is drawn by
     // one-sample MIS between the BSDF (guiding_bsdf_fraction of the samples) and a guide learned from the
-    // passes before: "sdtree" (practical path guiding's SD-tree) or "map" (the visibility map's guide,
-    // map_guide.h); "none" guides nothing. NEE stays for direct light. Both forms render it.
+    // passes before: "sdtree" (practical path guiding's SD-tree), "map" (the visibility map's guide,
+    // map_guide.h) or "sdtree+map" (both, a third strategy of the one-sample MIS: the guide's share split
+    // guiding_tree_share to the tree where both guide; each learns from every guided vertex); "none"
+    // guides nothing. NEE stays for direct light. Both forms render it.
     std::string guiding = "none";
+    bool guides_by_tree() const { return guiding == "sdtree" || guiding == "sdtree+map"; }
+    bool guides_by_map() const { return guiding == "map" || guiding == "sdtree+map"; }
+    // guiding=sdtree+map: the tree's share of the guide's directions where both guide (the map's guide has
+    // a table from the first pass on, the tree a leaf that guides only once it has learned).
+    float guiding_tree_share = 0.5f;
     // PPG's is 0.5; with NEE on classroom and living-room (docs/performance.md) 0.75 measured less noisy
     // (relVar 0.94x NEE's against 0.98-1.08x) and 0.9 no less noisy than 0.75.
     float guiding_bsdf_fraction = 0.75f;

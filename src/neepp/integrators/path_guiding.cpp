@@ -20,28 +20,28 @@ void set_mixture(VertexGuide &g, const SurfaceInteraction &si, float bsdf_fracti
 
 }  // namespace
 
-VertexGuide guide_at(const SDTree *tree, bool learn, const SurfaceInteraction &si, float bsdf_fraction) {
+VertexGuide guide_at(const SDTree *tree, const MapGuide *map, bool learn, const SurfaceInteraction &si,
+                     float bsdf_fraction, float tree_share) {
     VertexGuide g;
-    if (!tree || !guidable(si)) return g;
+    if ((!tree && !map) || !guidable(si)) return g;
     g.record = learn;
-    g.leaf = tree->leaf_at(si.p);
-    if (tree->can_guide(g.leaf)) {
-        g.tree = tree;
-        set_mixture(g, si, bsdf_fraction);
+    if (tree) {
+        g.leaf = tree->leaf_at(si.p);
+        if (tree->can_guide(g.leaf)) g.tree = tree;
     }
-    return g;
-}
-
-VertexGuide guide_at(const MapGuide *map, bool learn, const SurfaceInteraction &si, float bsdf_fraction) {
-    VertexGuide g;
-    if (!map || !guidable(si)) return g;
-    g.record = learn;
-    if (const MapGuide::Table *t = map->table_at(si.p)) {
-        g.map = map;
-        g.table = t;
-        g.p = si.p;
-        set_mixture(g, si, bsdf_fraction);
+    if (map) {
+        if (const MapGuide::Table *t = map->table_at(si.p)) {
+            g.map = map;
+            g.table = t;
+            g.p = si.p;
+        }
     }
+    // A share of 0 or 1 is one guide alone: the other is left out, not evaluated at zero weight.
+    if (g.tree && g.table && tree_share <= 0.f) g.tree = nullptr;
+    if (g.tree && g.table && tree_share >= 1.f) g.table = nullptr;
+    if (!g.guides()) return g;
+    g.tree_share = !g.table ? 1.f : !g.tree ? 0.f : tree_share;
+    set_mixture(g, si, bsdf_fraction);
     return g;
 }
 

@@ -1,10 +1,12 @@
 // Path guiding at a scattering vertex of the path integrator (both forms): the next direction drawn by
 // one-sample MIS between the BSDF (probability bsdf_fraction) and a guide, weighted by the mixture's
-// density. The guide is practical path guiding's SD-tree (Müller et al. 2017; guiding=sdtree) or the
-// visibility map's guide (guiding=map, map_guide.h). The BSDF's share is never zero, so every direction
+// density. The guide is practical path guiding's SD-tree (Müller et al. 2017; guiding=sdtree), the
+// visibility map's guide (guiding=map, map_guide.h), or their mixture (guiding=sdtree+map: three
+// strategies, the guide's share split between the two). The BSDF's share is never zero, so every direction
 // the BSDF can reach stays reachable whatever the guide says: the estimate is unbiased for any guide, a
 // wrong one only costs variance. Vertices whose BSDF has a delta part are left to the BSDF.
 #pragma once
+#include <algorithm>
 #include <array>
 #include "neepp/base/bsdf.h"
 #include "neepp/base/interaction.h"
@@ -20,6 +22,8 @@ struct VertexGuide {
     const MapGuide::Table *table = nullptr;
     Vec3 p;
     float bsdf_fraction = 1.f;
+    // The tree's share of the guide's density where both guide (1 with the tree alone, 0 with the map's).
+    float tree_share = 1.f;
     bool record = false;           // the vertex's sampled direction is recorded into the tree
     // Where the BSDF only reflects, the guide's directions are folded onto the side it reflects to (that
     // of `up`, the shading normal turned toward wi): a direction behind the surface is mirrored across
@@ -30,11 +34,18 @@ struct VertexGuide {
     static Vec3 mirror(const Vec3 &d, const Vec3 &n) { return d - n * (2.f * dot(d, n)); }
     // Whether a guide samples here (else the BSDF alone).
     bool guides() const { return tree || table; }
-    // The unfolded guide's density of d, and a direction from it (u_pick, u1: the map guide's cell and
-    // point; the tree reads u2 only).
-    float raw_pdf(const Vec3 &d) const { return tree ? tree->pdf(leaf, d) : map->pdf(*table, p, d); }
+    // The unfolded guide's density of d (the mixture's, where both guide), and a direction from it (u_pick:
+    // the tree or the map's guide, then the latter's cell; u1 the point in it; the tree reads u2 only).
+    float raw_pdf(const Vec3 &d) const {
+        if (!table) return tree->pdf(leaf, d);
+        if (!tree) return map->pdf(*table, p, d);
+        return tree_share * tree->pdf(leaf, d) + (1.f - tree_share) * map->pdf(*table, p, d);
+    }
     Vec3 raw_sample(float u_pick, float u1, Vec2 u2) const {
-        return tree ? tree->sample(leaf, u2) : map->sample(*table, p, u_pick, u1, u2);
+        if (!table) return tree->sample(leaf, u2);
+        if (!tree) return map->sample(*table, p, u_pick, u1, u2);
+        if (u_pick < tree_share) return tree->sample(leaf, u2);
+        return map->sample(*table, p, std::min((u_pick - tree_share) / (1.f - tree_share), kOneMinusEpsilon), u1, u2);
     }
     // The guide's own density of direction d.
     float guide_pdf(const Vec3 &d) const {
@@ -54,9 +65,11 @@ struct VertexGuide {
     }
 };
 
-// The guide at a vertex (tree or map null: no guiding). learn: the vertex's direction is recorded.
-VertexGuide guide_at(const SDTree *tree, bool learn, const SurfaceInteraction &si, float bsdf_fraction);
-VertexGuide guide_at(const MapGuide *map, bool learn, const SurfaceInteraction &si, float bsdf_fraction);
+// The guide at a vertex: the tree's leaf where it can guide, the map guide's table where the vertex's voxel
+// has one, either or both (null: that guide is off; neither: the BSDF samples alone). learn: the vertex's
+// direction is recorded. tree_share: the tree's share of the guide where both guide.
+VertexGuide guide_at(const SDTree *tree, const MapGuide *map, bool learn, const SurfaceInteraction &si,
+                     float bsdf_fraction, float tree_share);
 
 // The next direction by one-sample MIS: u_choice picks the strategy, (u1, u2) drive it. The sample's pdf
 // is the mixture's and its weight f·|cos| / pdf; bsdf_pdf receives the BSDF's own density of it. A

@@ -3,6 +3,7 @@
 #include <cstring>
 #include <memory>
 #include <stdexcept>
+#include <utility>
 #include <vector>
 #include "neepp/guiding/sd_tree.h"
 #include "neepp/base/light_selection_learner.h"
@@ -13,7 +14,8 @@ namespace neepp {
 
 namespace {
 constexpr char kMagicGuide[8] = {'N', 'E', 'E', 'P', 'P', 'P', 'G', '1'};  // shadow, guide
-constexpr char kMagic[8] = {'N', 'E', 'E', 'P', 'P', 'P', 'G', '2'};       // shadow, guide, light
+constexpr char kMagicLight[8] = {'N', 'E', 'E', 'P', 'P', 'P', 'G', '2'};  // shadow, guide, light
+constexpr char kMagic[8] = {'N', 'E', 'E', 'P', 'P', 'P', 'G', '3'};       // shadow, tree, light, map guide
 
 template <typename T> void put(std::string &out, const T &v) { out.append(reinterpret_cast<const char *>(&v), sizeof v); }
 template <typename T> T get(const std::string &data, size_t &offset) {
@@ -42,24 +44,31 @@ std::string PathState::encode(bool framed) const {
     out += guide;
     put(out, uint64_t(light.size()));
     out += light;
+    put(out, uint64_t(map_guide.size()));
+    out += map_guide;
     return out;
 }
 
-PathState PathState::decode(const std::string &bytes, bool framed) {
+PathState PathState::decode(const std::string &bytes, bool framed, bool map_guided) {
     PathState s;
     if (!framed || bytes.empty()) {
         s.shadow = bytes;
         return s;
     }
-    const bool old = bytes.size() >= sizeof kMagicGuide && std::memcmp(bytes.data(), kMagicGuide, sizeof kMagicGuide) == 0;
-    if (!old && (bytes.size() < sizeof kMagic || std::memcmp(bytes.data(), kMagic, sizeof kMagic) != 0))
+    auto starts = [&](const char (&magic)[8]) {
+        return bytes.size() >= sizeof magic && std::memcmp(bytes.data(), magic, sizeof magic) == 0;
+    };
+    const int version = starts(kMagicGuide) ? 1 : starts(kMagicLight) ? 2 : starts(kMagic) ? 3 : 0;
+    if (version == 0)
         throw std::runtime_error("path state: not a guided or learning path integrator's state (was it saved with the same "
                                  "-I guiding and light_sampler?)");
     size_t offset = sizeof kMagic;
     s.guide_spp = get<int32_t>(bytes, offset);
     s.shadow = get_bytes(bytes, offset);
     s.guide = get_bytes(bytes, offset);
-    if (!old) s.light = get_bytes(bytes, offset);
+    if (version >= 2) s.light = get_bytes(bytes, offset);
+    if (version >= 3) s.map_guide = get_bytes(bytes, offset);
+    else if (map_guided) s.map_guide = std::exchange(s.guide, std::string());
     if (offset != bytes.size()) throw std::runtime_error("path state: trailing bytes");
     return s;
 }
@@ -75,7 +84,7 @@ std::string PathIntegrator::save_state() const {
         s.guide = guide_->save();
         s.guide_spp = guide_spp_;
     }
-    if (map_guide_ && guide_learns_) s.guide = map_guide_->save();
+    if (map_guide_ && guide_learns_) s.map_guide = map_guide_->save();
     if (learner_) s.light = learner_->save_state();
     return s.encode(framed_state());
 }
@@ -87,24 +96,23 @@ std::string PathIntegrator::save_state() const {
 std::string PathIntegrator::merge_states(const std::string &base, const std::vector<std::string> &learned) const {
     if (!framed_state()) return shadow_->merge_states(base, learned);
     if (learned.empty()) return base;
-    const PathState b = PathState::decode(base, true);
+    const PathState b = PathState::decode(base, true, options_.guides_by_map());
     std::vector<std::string> shadows, lights, map_guides;
     std::vector<SDTree> trees;
     PathState merged;
     for (const std::string &l : learned) {
-        PathState s = PathState::decode(l, true);
+        PathState s = PathState::decode(l, true, options_.guides_by_map());
         shadows.push_back(std::move(s.shadow));
         lights.push_back(std::move(s.light));
-        if (!s.guide.empty() && options_.guiding == "map") map_guides.push_back(std::move(s.guide));
-        else if (!s.guide.empty()) trees.push_back(SDTree::decode(s.guide));
+        if (!s.map_guide.empty()) map_guides.push_back(std::move(s.map_guide));
+        if (!s.guide.empty()) trees.push_back(SDTree::decode(s.guide));
         merged.guide_spp = std::max(merged.guide_spp, s.guide_spp);
     }
     merged.shadow = shadow_->merge_states(b.shadow, shadows);
     std::vector<const SDTree *> pointers;
     for (const SDTree &t : trees) pointers.push_back(&t);
-    merged.guide = !map_guides.empty() ? MapGuide::merge(b.guide, map_guides)
-                   : pointers.empty()  ? b.guide
-                                       : SDTree::merge(pointers).save();
+    merged.guide = pointers.empty() ? b.guide : SDTree::merge(pointers).save();
+    merged.map_guide = map_guides.empty() ? b.map_guide : MapGuide::merge(b.map_guide, map_guides);
     merged.light = merge_light_selection_states(options_.light_sampler, b.light, lights);
     return merged.encode(true);
 }

@@ -11,15 +11,17 @@ namespace neepp {
 
 struct PathState {
     std::string shadow;
-    std::string guide;   // SDTree::save() or MapGuide::save(); empty: none yet
+    std::string guide;      // SDTree::save(); empty: none yet
     int32_t guide_spp = 0;
-    std::string light;   // the learning light sampler's; empty: none
+    std::string light;      // the learning light sampler's; empty: none
+    std::string map_guide;  // MapGuide::save(); empty: none
 
     // framed: guiding or a learning light sampler, whose parts need a frame around the shadow state.
     std::string encode(bool framed) const;
     // Throws std::runtime_error if a framed state is malformed; an empty state is an empty one. Reads the
-    // frame of guided states saved before the light part existed too.
-    static PathState decode(const std::string &bytes, bool framed);
+    // frames of the states saved before the light part (G1) and the map guide's own part (G2, which held a
+    // guiding=map state's guide in `guide`: decode(..., map_guided) moves it) existed too.
+    static PathState decode(const std::string &bytes, bool framed, bool map_guided = false);
 };
 
 }  // namespace neepp
