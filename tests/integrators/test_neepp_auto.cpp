@@ -84,7 +84,7 @@ TEST(NeeppAuto, EveryCandidateItMayPickAgreesWithPlainNee) {
     const std::string path = write_temp_scene(kCourtXml);
     auto scene = load_scene(path);
     const BlockMoments nee = block_moments(path, "path", Options(OptionMap{{"max_depth", "4"}}), 4, 32, 500);
-    for (const AutoCandidate &c : auto_candidates()) {
+    for (const AutoCandidate &c : auto_candidates(true)) {  // guiding's candidate too
         std::vector<std::vector<double>> per_seed;
         for (int s = 0; s < 4; ++s) {
             OptionMap o = c.overrides;
@@ -92,7 +92,7 @@ TEST(NeeppAuto, EveryCandidateItMayPickAgreesWithPlainNee) {
             auto fresh = make(o);  // the candidate's own state, as a first render would save it
             fresh->prepare(*scene);
             const std::string state = c.name + '\n' + fresh->save_state();
-            auto integrator = make({{"neepp", "auto"}, {"max_depth", "4"}});
+            auto integrator = make({{"neepp", "auto"}, {"max_depth", "4"}, {"auto_guiding", "true"}});
             RenderJob job;
             job.spp = 32;
             job.seed = 900 + 31 * s;
@@ -103,6 +103,46 @@ TEST(NeeppAuto, EveryCandidateItMayPickAgreesWithPlainNee) {
         }
         expect_same_image(nee, moments_over_seeds(per_seed), "neepp=auto forced to " + c.name);
     }
+}
+
+// -I auto_guiding=true: path guiding is a candidate on every scene, one light included (a pilot then runs
+// where none did), and learns from its warm-up passes before it is measured; the pick follows the rule.
+TEST(NeeppAuto, GuidingIsACandidateWhereAsked) {
+    auto room = load_scene(write_temp_scene(kGlossyRoomXml));
+    auto integrator = make({{"neepp", "auto"}, {"auto_guiding", "true"}});
+    auto &auto_integrator = dynamic_cast<AutoIntegrator &>(*integrator);
+    auto_integrator.prepare(*room);
+    const auto &pilot = auto_integrator.pilot();
+    ASSERT_EQ(pilot.size(), 2u) << "one light: plain NEE and guiding";
+    EXPECT_EQ(pilot[0].name, "nee");
+    EXPECT_EQ(pilot[1].name, "guided");
+    for (const AutoPilotResult &r : pilot) {
+        EXPECT_GT(r.relative_variance, 0) << r.name;
+        EXPECT_GT(r.seconds_per_sample, 0) << r.name;
+    }
+    EXPECT_EQ(auto_integrator.picked(), pilot[1].efficiency > AutoIntegrator::kMargin ? "guided" : "nee");
+    // Forced to guiding (as a resumed render is), the guide it renders with learned from the warm-up.
+    auto forced = make({{"neepp", "auto"}, {"auto_guiding", "true"}});
+    auto fresh = make({{"guiding", "sdtree"}});
+    fresh->prepare(*room);
+    RenderJob job;
+    job.spp = 8;
+    job.seed = 5;
+    render(*room, *fresh, job);
+    const std::string state = "guided\n" + fresh->save_state();
+    job.integrator_state = &state;
+    render(*room, *forced, job);
+    EXPECT_EQ(dynamic_cast<AutoIntegrator &>(*forced).picked(), "guided");
+    EXPECT_EQ(forced->describe()["guiding"], "sdtree");
+    EXPECT_TRUE(forced->statistics().contains("guiding"));
+    // Without the option: no guiding candidate, and no pilot with one light.
+    auto plain = make({{"neepp", "auto"}});
+    plain->prepare(*room);
+    EXPECT_EQ(dynamic_cast<AutoIntegrator &>(*plain).pilot().size(), 1u);
+    EXPECT_THROW(make({{"neepp", "auto"}, {"guiding", "sdtree"}}), std::invalid_argument);
+    EXPECT_THROW(make_integrator("volpath", Options(OptionMap{{"neepp", "auto"}, {"auto_guiding", "true"}})),
+                 std::invalid_argument);
+    EXPECT_THROW(make({{"auto_guiding", "true"}}), std::invalid_argument) << "only with neepp=auto";
 }
 
 TEST(NeeppAuto, RefusesAStateThatNamesNoCandidate) {

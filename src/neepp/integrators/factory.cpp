@@ -161,21 +161,25 @@ std::unique_ptr<PathIntegrator> make_path(const Options &options, bool volumetri
 // unused only if no candidate reads it.
 std::unique_ptr<Integrator> make_auto_path(const Options &options, bool volumetric) {
     if (options.has("guiding") && options.get_string("guiding", "none") != "none")
-        throw std::invalid_argument("neepp=auto with guiding is refused: its pilot measures candidates without one; "
-                                    "use neepp=off");
+        throw std::invalid_argument("neepp=auto with guiding is refused: guiding is a candidate of its own "
+                                    "(-I auto_guiding=true), or use neepp=off");
+    const bool guiding = options.get_bool("auto_guiding", false);
+    if (guiding && volumetric)
+        throw std::invalid_argument("auto_guiding: volpath has no path guiding (it is the path integrator's)");
     for (const char *key : {"light_sampler", "within_light", "shadow_rays"})
         if (options.has(key))
             throw std::invalid_argument(std::string("neepp=auto chooses light_sampler, within_light and shadow_rays itself: "
                                                     "drop -I ") + key + ", or use neepp=off");
     std::map<std::string, std::string> values = options.values();
     values.erase("neepp");
+    values.erase("auto_guiding");
     auto candidate_options = [values](const AutoCandidate &c) {
         Options o(values);
         for (const auto &[k, v] : c.overrides) o.set(k, v);
         return o;
     };
     std::set<std::string> read;
-    for (const AutoCandidate &c : auto_candidates()) {
+    for (const AutoCandidate &c : auto_candidates(guiding)) {
         Options o = candidate_options(c);
         make_path(o, volumetric);
         const std::vector<std::string> unused = o.unused();
@@ -183,7 +187,7 @@ std::unique_ptr<Integrator> make_auto_path(const Options &options, bool volumetr
             if (std::find(unused.begin(), unused.end(), k) == unused.end()) read.insert(k);
     }
     for (const std::string &k : read) options.get_string(k, "");  // read by some candidate: not unused
-    return std::make_unique<AutoIntegrator>(auto_candidates(),
+    return std::make_unique<AutoIntegrator>(auto_candidates(guiding),
                                             [candidate_options, volumetric](const AutoCandidate &c) {
                                                 return make_path(candidate_options(c), volumetric);
                                             });

@@ -104,7 +104,7 @@ std::vector<double> relative_variances(const std::vector<PilotFigures> &figures)
 
 }  // namespace
 
-const std::vector<AutoCandidate> &auto_candidates() {
+const std::vector<AutoCandidate> &auto_candidates(bool guiding) {
     static const std::vector<AutoCandidate> candidates = {
         {"nee", {}, [](const Scene &) { return true; }},
         // Choices between lights by what each gives every voxel of the scene, without the map, then with
@@ -116,7 +116,16 @@ const std::vector<AutoCandidate> &auto_candidates() {
         // and where they win a whole render they win by less than the margin that keeps the pilot's noise
         // from picking a loser (docs/neepp.md has the measurements).
     };
-    return candidates;
+    // Guiding only where asked: it applies on every scene, so a scene with one light, which runs no pilot
+    // by default, would pay one (at 64 spp about 5 % of classroom's render), and on none of the scenes
+    // measured did guiding beat plain NEE (docs/performance.md). Its guide learns from three pilot passes
+    // before it is measured: far less than a render's passes teach it, so the pilot underrates it.
+    static const std::vector<AutoCandidate> with_guiding = [] {
+        std::vector<AutoCandidate> c = candidates;
+        c.push_back({"guided", {{"guiding", "sdtree"}}, [](const Scene &) { return true; }, 3});
+        return c;
+    }();
+    return guiding ? with_guiding : candidates;
 }
 
 AutoIntegrator::AutoIntegrator(std::vector<AutoCandidate> candidates, Make make)
@@ -155,8 +164,12 @@ void AutoIntegrator::prepare(const Scene &scene) {
         const auto t0 = std::chrono::steady_clock::now();
         integrator->prepare(scene);
         if (keeper && !seeded && keeper->map().pair_count() > 0) seeded.emplace(keeper->grid(), keeper->map());
-        const PilotFigures warm_up = run_pilot(scene, *integrator, 0);
-        integrator->end_pass(scene, PassStatistics{0, kPilotSpp, warm_up.sample_variance});
+        for (int w = 0; w < candidates_[k].warm_up_passes; ++w) {
+            // Sample indices past the measured passes' beyond the first: no two passes share numbers.
+            const int first = w == 0 ? 0 : (kPilotPasses + w) * kPilotSpp;
+            const PilotFigures warm_up = run_pilot(scene, *integrator, first);
+            integrator->end_pass(scene, PassStatistics{w, (w + 1) * kPilotSpp, warm_up.sample_variance});
+        }
         AutoPilotResult r;
         r.name = candidates_[k].name;
         r.prepare_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();

@@ -1,6 +1,6 @@
 // `-I neepp=auto`: which of NEE++'s uses pays on a scene is measured on it, not guessed. Each candidate
 // (plain NEE, and each choice between lights by voxel, with and without the map, on scenes with several
-// lights) is prepared and renders the
+// lights; with auto_guiding, path guiding by the SD-tree on any scene) is prepared and renders the
 // same pilot: a few samples of pixels spread over the film, with the same random numbers. Its efficiency
 // is 1 / (relative variance per sample × CPU time per sample); the render goes on with the most efficient,
 // and with plain NEE unless another beats it by a margin, so that the pilot's own noise cannot pick a
@@ -19,10 +19,15 @@ struct AutoCandidate {
     std::string name;                    // "nee", "light-visibility", ...
     std::map<std::string, std::string> overrides;  // options set on top of the user's
     std::function<bool(const Scene &)> applies;    // whether it can differ from plain NEE on the scene
+    // Pilot passes it renders and learns from (end_pass after each) before it is measured: one for a light
+    // choice (its tables built, its first decisions taken), more for a guide, which learns from its passes.
+    int warm_up_passes = 1;
 };
 
-// The candidates of `neepp=auto` for the path integrator; the first is plain NEE.
-const std::vector<AutoCandidate> &auto_candidates();
+// The candidates of `neepp=auto` for the path integrator; the first is plain NEE. guiding
+// (-I auto_guiding=true): practical path guiding's too ("guided"), which applies on every scene, so that
+// even a scene with one light then runs a pilot.
+const std::vector<AutoCandidate> &auto_candidates(bool guiding = false);
 
 struct AutoPilotResult {
     std::string name;

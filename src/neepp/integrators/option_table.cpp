@@ -55,6 +55,9 @@ std::vector<IntegratorDoc> make_docs() {
                             "off: the options below as given; auto: with several lights, a pilot measures plain NEE, "
                             "light_sampler=spatial-oriented and light_sampler=visibility, and renders with the most "
                             "efficient (docs/neepp.md)", ""});
+    path.options.push_back({"auto_guiding", "false",
+                            "neepp=auto: path guiding (guiding=sdtree) is a candidate too, on every scene (a pilot "
+                            "then runs with one light as well)", "neepp=auto"});
     path.options.push_back({"form", "fast",
                             "fast (paths in batches, the default) or reference (one path at a time, the estimator's "
                             "definition: the same image in expectation, slower)", ""});
@@ -104,7 +107,7 @@ std::vector<IntegratorDoc> make_docs() {
     volpath.description = "volumetric path tracing through participating media (Mitsuba 3's volpath): null surfaces "
                           "crossed without a bounce, shadow rays through media and null surfaces; the reference form "
                           "only";
-    std::erase_if(volpath.options, [](const OptionDoc &o) { return o.name == "form" || o.name.rfind("guiding", 0) == 0 || o.name.rfind("ris", 0) == 0;
+    std::erase_if(volpath.options, [](const OptionDoc &o) { return o.name == "form" || o.name == "auto_guiding" || o.name.rfind("guiding", 0) == 0 || o.name.rfind("ris", 0) == 0;
     });
     docs.push_back(volpath);
 
