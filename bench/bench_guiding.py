@@ -62,7 +62,8 @@ def main() -> None:
         xml = REPO / "scenes" / a.scene / "scene.xml"
     configs = [parse_config(c) for c in a.config]
     print("machine:", os.popen("uptime").read().strip(), flush=True)
-    out = Path(a.out) / f"{a.scene}_{a.resx}x{a.resy}_{a.spp}"
+    # --scene is a folder of the shared scenes or a path to a scene's folder: its name names the output.
+    out = Path(a.out) / f"{Path(a.scene).name}_{a.resx}x{a.resy}_{a.spp}"
 
     def one(name, args, binary, seed):
         return runner.run_neepp(xml, out / f"{name}_{seed}.exr", spp=a.spp, seed=seed, threads=1, resx=a.resx,
