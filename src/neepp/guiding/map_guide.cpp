@@ -177,36 +177,54 @@ void MapGuide::build_tables(const VisibilityMap *map) {
         grid_.voxel_coords(cell, x, y, z);
         return grid_.bounds().lo + Vec3(float(x) + 0.5f, float(y) + 0.5f, float(z) + 0.5f) * e;
     };
-    std::vector<double> w(cells);
+    std::vector<Vec3> bright_center(bright.size());
+    for (size_t b = 0; b < bright.size(); ++b)
+        if (!grid_.is_direction_cell(bright[b])) bright_center[b] = center(bright[b]);
+    // A table's weights are sparse (its targets and the bright cells its voxel has traced to): only the
+    // cells touched are visited, in ascending order, so that every sum adds what the dense loop over all
+    // cells added (zeros leave a sum unchanged) and the tables are the same to the bit.
+    std::vector<double> w(cells, 0.0);
+    std::vector<uint32_t> touched;
     for (uint32_t i : order) {
         const Voxel &v = voxels_[i];
-        std::fill(w.begin(), w.end(), 0.0);
         const double n = double(v.samples);
+        touched.clear();
         // Learned: the summed flux from each target (n times the mean flux estimate).
-        for (const auto &[target, t] : v.total) w[target] += t.flux / (n + k);
+        for (const auto &[target, t] : v.total) {
+            w[target] += t.flux / (n + k);
+            touched.push_back(target);
+        }
         if (map && k > 0) {
             const Vec3 ci = center(i);
-            for (uint32_t j : bright) {
-                double solid_angle = bin_solid_angle;
-                if (!grid_.is_direction_cell(j)) {
-                    const double d2 = double(squared_norm(center(j) - ci));
-                    solid_angle = d2 > 0 ? std::min(2.0 * M_PI, mean_area / d2) : 2.0 * M_PI;
-                }
+            for (size_t b = 0; b < bright.size(); ++b) {
+                const uint32_t j = bright[b];
                 // Pairs the map has traced only: its 1/2 for an unknown pair would send the prior to every
                 // bright voxel behind every wall.
                 const PairCounts c = map->counts(i, j);
                 if (c.traced == 0) continue;
+                double solid_angle = bin_solid_angle;
+                if (!grid_.is_direction_cell(j)) {
+                    const double d2 = double(squared_norm(bright_center[b] - ci));
+                    solid_angle = d2 > 0 ? std::min(2.0 * M_PI, mean_area / d2) : 2.0 * M_PI;
+                }
                 w[j] += k * double(VisibilityMap::estimate(c)) * radiance[j] * solid_angle / (n + k);
+                touched.push_back(j);
             }
         }
+        std::sort(touched.begin(), touched.end());
+        touched.erase(std::unique(touched.begin(), touched.end()), touched.end());
         double sum = 0;
-        for (double x : w) sum += x;
-        if (!(sum > 0) || !std::isfinite(sum)) continue;
+        for (uint32_t j : touched) sum += w[j];
+        if (!(sum > 0) || !std::isfinite(sum)) {
+            for (uint32_t j : touched) w[j] = 0.0;
+            continue;
+        }
         Table t;
         t.pmf.assign(cells, 0.f);
         double running = 0;
-        for (uint32_t j = 0; j < cells; ++j) {
+        for (uint32_t j : touched) {
             const float p = float(w[j] / sum);
+            w[j] = 0.0;  // ready for the next table
             if (!(p > 0)) continue;
             t.pmf[j] = p;
             running += double(p);
