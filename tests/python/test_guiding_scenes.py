@@ -25,7 +25,7 @@ from neepp_tools import REPO_ROOT, metrics, runner
 from test_project_scenes import _defines
 
 OUT = REPO_ROOT / ".cache" / "test_guiding_scenes"
-W, H = 160, 90
+W, H = 128, 72
 # spp per scene: enough that the mean's standard error is about 1 % or less (veach-ajar and the scenes lit
 # through a gap are the noisiest).
 SHARED = {"bathroom": 64, "classroom": 64, "cornell-box": 64, "living-room": 64, "staircase": 64, "veach-ajar": 128}
