@@ -8,6 +8,7 @@
 #include "common/chi2.h"
 #include "neepp/integrators/path.h"
 #include "neepp/integrators/path_guiding.h"
+#include "neepp/integrators/path_state.h"
 #include "neepp/io/image.h"
 #include "neepp/sampling/rng.h"
 #include "neepp/scene/scene.h"
@@ -549,6 +550,53 @@ TEST(BothGuides, SameImageToTheBitAndStateCarriesBoth) {
     const SDTree *trees[] = {&tree_a, &tree_b};
     EXPECT_TRUE(*pi.guide() == SDTree::merge(trees));
     EXPECT_EQ(pi.map_guide()->records(), records_a + records_b);
+}
+
+
+// The path state's frames: G3 (shadow, tree, light, map guide) round-trips; the earlier G2 (shadow, guide,
+// light) and G1 (shadow, guide) still read, a G2 guide going to the map guide's part when the integrator
+// guides by the map (where guiding=map kept it then); anything else is refused.
+TEST(PathStateFrames, ReadsEveryLayoutItWrote) {
+    PathState s;
+    s.shadow = "shadow bytes";
+    s.guide = "tree";
+    s.guide_spp = 24;
+    s.light = "light";
+    s.map_guide = "map guide";
+    const PathState back = PathState::decode(s.encode(true), true);
+    EXPECT_EQ(back.shadow, s.shadow);
+    EXPECT_EQ(back.guide, s.guide);
+    EXPECT_EQ(back.guide_spp, 24);
+    EXPECT_EQ(back.light, s.light);
+    EXPECT_EQ(back.map_guide, s.map_guide);
+    EXPECT_EQ(PathState::decode(s.encode(false), false).shadow, s.shadow) << "unframed: the shadow state alone";
+    auto frame = [](const char *magic, const std::vector<std::string> &parts) {
+        std::string out(magic, 8);
+        const int32_t spp = 7;
+        out.append(reinterpret_cast<const char *>(&spp), sizeof spp);
+        for (const std::string &part : parts) {
+            const uint64_t n = part.size();
+            out.append(reinterpret_cast<const char *>(&n), sizeof n);
+            out += part;
+        }
+        return out;
+    };
+    const std::string g2 = frame("NEEPPPG2", {"shadow", "saved guide", "light"});
+    const PathState tree_guided = PathState::decode(g2, true, false);
+    EXPECT_EQ(tree_guided.guide, "saved guide");
+    EXPECT_TRUE(tree_guided.map_guide.empty());
+    EXPECT_EQ(tree_guided.light, "light");
+    EXPECT_EQ(tree_guided.guide_spp, 7);
+    const PathState map_guided = PathState::decode(g2, true, true);
+    EXPECT_TRUE(map_guided.guide.empty());
+    EXPECT_EQ(map_guided.map_guide, "saved guide");
+    const PathState g1 = PathState::decode(frame("NEEPPPG1", {"shadow", "saved guide"}), true, false);
+    EXPECT_EQ(g1.shadow, "shadow");
+    EXPECT_EQ(g1.guide, "saved guide");
+    EXPECT_TRUE(g1.light.empty());
+    EXPECT_THROW(PathState::decode(frame("NEEPPPG9", {"shadow", "guide", "light"}), true), std::runtime_error);
+    EXPECT_THROW(PathState::decode(g2 + "x", true), std::runtime_error) << "trailing bytes";
+    EXPECT_THROW(PathState::decode(g2.substr(0, g2.size() - 2), true), std::runtime_error) << "truncated";
 }
 
 }  // namespace
