@@ -87,3 +87,17 @@ TEST(OptionTable, NonFiniteNumbersAreRefused) {
         }
     }
 }
+
+// An option another option's setting turns on (the table's `needs`), given without it, is refused saying
+// which setting reads it; an option no integrator knows is refused plainly.
+TEST(OptionTable, AnOptionReadOnlyWithAnotherSaysWhich) {
+    try {
+        make_integrator("path", Options(std::map<std::string, std::string>{{"auto_guiding", "true"}, {"bogus", "1"}}));
+        ADD_FAILURE() << "auto_guiding without neepp=auto was accepted";
+    } catch (const std::invalid_argument &e) {
+        const std::string what = e.what();
+        EXPECT_NE(what.find("auto_guiding (read only with -I neepp=auto)"), std::string::npos) << what;
+        EXPECT_NE(what.find("bogus"), std::string::npos) << what;
+        EXPECT_EQ(what.find("bogus ("), std::string::npos) << what;
+    }
+}

@@ -8,6 +8,7 @@
 #include <stdexcept>
 #include "neepp/integrators/bdpt.h"
 #include "neepp/integrators/neepp_auto.h"
+#include "neepp/integrators/option_table.h"
 #include "neepp/integrators/path.h"
 #include "neepp/integrators/pssmlt.h"
 #include "neepp/light_selection/factory.h"
@@ -266,8 +267,17 @@ std::unique_ptr<Integrator> make_integrator(const std::string &name, const Optio
         throw std::invalid_argument("unknown integrator '" + name + "' (supported: path, volpath, bdpt, light, pssmlt)");
     }
     if (auto unused = options.unused(); !unused.empty()) {
+        // An option of the integrator that another one's setting turns on (its table's `needs`) says which.
+        std::map<std::string, std::string> needs;
+        for (const IntegratorDoc &d : integrator_docs())
+            if (d.name == name)
+                for (const OptionDoc &o : d.options)
+                    if (!o.needs.empty()) needs[o.name] = o.needs;
         std::string list;
-        for (auto &k : unused) list += (list.empty() ? "" : ", ") + k;
+        for (auto &k : unused) {
+            list += (list.empty() ? "" : ", ") + k;
+            if (auto it = needs.find(k); it != needs.end()) list += " (read only with -I " + it->second + ")";
+        }
         throw std::invalid_argument("integrator '" + name + "' has no option(s): " + list);
     }
     return integrator;
