@@ -138,6 +138,47 @@ TEST(NeeppRender, ReproducibleForAGivenSeed) {
     }
 }
 
+// A policy that says it does not read a query's contribution decides the same whatever the contribution
+// (BDPT then works out its MIS weight only after the test), and the adaptive policy, which reads it, does not.
+TEST(NeeppRender, ReadsTheContributionOnlyWhereItSaysSo) {
+    for (std::string policy : {"nee", "neepp", "neepp-cv", "neepp-adaptive"}) {
+        auto scene = load_scene(two_rooms_path());
+        auto integ = make_integrator("path", Options(OptionMap{{"shadow_rays", policy}}));
+        RenderJob job;
+        job.spp = 8;
+        render(*scene, *integ, job);  // the map seeded and learned, the adaptive scale calibrated
+        const ShadowRayTester &tester = dynamic_cast<PathIntegrator &>(*integ).shadow_rays();
+        const BBox b = scene->bounds();
+        std::unique_ptr<Sampler> points = make_sampler("independent", 5);
+        points->start_sample(0, 0, 0);
+        int differ = 0;
+        for (int i = 0; i < 2000; ++i) {
+            auto point = [&] {
+                return b.lo + Vec3(points->next_1d(), points->next_1d(), points->next_1d()) * b.extent();
+            };
+            ShadowQuery q;
+            q.from = point();
+            q.to = point();
+            q.ray = Ray{q.from, normalize(q.to - q.from), 0.f, norm(q.to - q.from)};
+            ShadowTest tests[2];
+            for (int k = 0; k < 2; ++k) {
+                q.unoccluded = Color(k == 0 ? 1e-4f : 10.f);
+                std::unique_ptr<Sampler> sampler = make_sampler("independent", 9);
+                sampler->start_sample(uint32_t(i), 0, 0);
+                RenderCounters counters;
+                tests[k] = tester.begin_test(q, *sampler, counters);
+            }
+            const bool same = tests[0].trace == tests[1].trace && tests[0].if_visible == tests[1].if_visible &&
+                              tests[0].if_occluded == tests[1].if_occluded && tests[0].if_skipped == tests[1].if_skipped;
+            if (!same) ++differ;
+            if (!tester.reads_contribution()) ASSERT_TRUE(same) << policy << ": query " << i;
+        }
+        if (tester.reads_contribution()) EXPECT_GT(differ, 0) << policy << " says it reads the contribution";
+        else EXPECT_EQ(differ, 0) << policy;
+        EXPECT_EQ(tester.reads_contribution(), policy == "neepp-adaptive") << policy;
+    }
+}
+
 // The efficiency target trades rays for variance by their cost: nearly free rays are (almost) all traced,
 // expensive ones skipped more than the paper's rule would.
 TEST(NeeppRender, AdaptiveEfficiencyFollowsTheShadowRayCost) {

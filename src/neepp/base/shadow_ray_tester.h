@@ -55,6 +55,10 @@ public:
     // in q) and prefetches what begin_test(q) will read (the pair's map entry). Optional: begin_test
     // gives the same answer without it.
     virtual void prepare(ShadowQuery &q) const {}
+    // Whether begin_test reads q.unoccluded (a contribution-aware policy). Where it does not, an
+    // integrator may leave the expensive part of the contribution (BDPT's MIS weight) out of the query and
+    // work it out only where the test's weight is not zero.
+    virtual bool reads_contribution() const { return true; }
     virtual std::string policy() const = 0;
     // Hooks of the render loop, both single-threaded: prepare() before the first pass (build or load the
     // visibility map), end_pass() after each pass (merge what the pass learned; the next pass reads the

@@ -247,15 +247,22 @@ Color BDPTIntegrator::connect(const std::vector<PathVertex> &light, const std::v
         to = &qs;
     }
     if (is_black(L)) return Color(0.f);
-    if (options_.strategy_s < 0 ? !options_.light_tracer : options_.strategy_mis)
-        L *= mis_weight(light, camera, sampled, s, t);
+    const bool weighted = options_.strategy_s < 0 ? !options_.light_tracer : options_.strategy_mis;
+    // The MIS weight walks the whole path, the larger part of a connection's cost, and most connections
+    // of a scene with hard visibility are occluded: unless the shadow-ray policy reads the contribution,
+    // the weight is worked out after the test, and only where the test's weight is not zero.
+    const bool weigh_first = weighted && (!test || queries_->reads_contribution());
+    if (weigh_first) L *= mis_weight(light, camera, sampled, s, t);
     if (!test || is_black(L)) return L;
     ShadowQuery q;
     q.ray = connection_ray(*from, *to);
     q.from = from->p;
     q.to = to->infinite ? from->p + to->dir : to->p;  // a ray to the sky is mapped by its direction
     q.unoccluded = L;
-    return L * test_visibility(*queries_, *ctx_.scene, q, sampler, counters);
+    const float v = test_visibility(*queries_, *ctx_.scene, q, sampler, counters);
+    if (v == 0.f) return Color(0.f);
+    if (weighted && !weigh_first) L *= mis_weight(light, camera, sampled, s, t);
+    return L * v;
 }
 
 void BDPTIntegrator::splat_light_path(const std::vector<PathVertex> &light, Sampler &sampler, RenderCounters &counters,

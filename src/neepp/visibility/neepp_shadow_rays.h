@@ -96,6 +96,8 @@ public:
     void end_test(const ShadowTest &test, bool occluded) const override;
     void prepare(ShadowQuery &q) const override;
     std::string policy() const override { return to_string(options_.policy); }
+    // The adaptive policy's trace probability (and its ray-budget calibration) reads it.
+    bool reads_contribution() const override { return options_.policy == ShadowRayPolicy::NeeppAdaptive; }
     void prepare(const Scene &scene) override;
     void end_pass(const PassStatistics &pass) override;
     // The phase, the adaptive calibration, the totals and the map (its known pairs).

@@ -8,6 +8,7 @@ namespace neepp {
 class TraceAllShadowRays final : public ShadowRayTester {
 public:
     ShadowTest begin_test(const ShadowQuery &, Sampler &, RenderCounters &) const override { return {}; }
+    bool reads_contribution() const override { return false; }
     std::string policy() const override { return "nee"; }
 };
 
