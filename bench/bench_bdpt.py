@@ -1,6 +1,7 @@
 #!/usr/bin/env python3
 """Bidirectional methods at equal time: path tracing (NEE, and NEE++'s adaptive policy), BDPT, BDPT with
-NEE++ light-path selection (K candidates from a pool) and light tracing.
+NEE++'s shadow-ray rejection on its connections (bdpt-neepp-rays), BDPT with NEE++ light-path selection
+(K candidates from a pool) and light tracing.
 
 Every method gets the same wall time on each scene, twice with different seeds. The table gives relMSE
 against the Mitsuba 3 reference (box-downsampled to the render's resolution), the relative variance from
@@ -31,6 +32,7 @@ METHODS = {
     "path": ("path", {}),
     "path-neepp": ("path", {"shadow_rays": "neepp-adaptive"}),
     "bdpt": ("bdpt", {}),
+    "bdpt-neepp-rays": ("bdpt", {"shadow_rays": "neepp"}),
     "bdpt-neepp-k4": ("bdpt", {"light_paths": "neepp", "candidates": "4"}),
     "bdpt-neepp-k8": ("bdpt", {"light_paths": "neepp", "candidates": "8"}),
     "bdpt-neepp-k16": ("bdpt", {"light_paths": "neepp", "candidates": "16"}),
