@@ -28,7 +28,7 @@ before the next light sample, so maxdepth 0 is the emitters seen directly and 1 
 keeps strategies with s + t - 2 <= maxdepth, i.e. segments - 1. So pbrt maxdepth = max_depth - 1
 (--check-depth renders max_depth 1..4 with both integrators of both renderers to show it).
 
-Load: as bench/tungsten_peer.py (its wait_quiet and LoadMeter are used): a round whose render saw more than
+Load: as bench/tungsten_peer.py (bench/peer_rounds.py, which both use): a round whose render saw more than
 --max-other-load cores used by others is run again (--retries), --wait-quiet S waits for a quiet machine.
 
 pbrt-v4's scenes. --pbrt-scenes DIR holds <scene>/pbrt/scene-v4.pbrt and its models/ and textures/: the
@@ -84,10 +84,8 @@ from __future__ import annotations
 
 import argparse
 import json
-import math
 import re
 import shlex
-import statistics
 import struct
 import subprocess
 import sys
@@ -101,8 +99,9 @@ REPO = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(REPO / "python"))
 sys.path.insert(0, str(REPO / "bench"))
 
-from neepp_tools import REFERENCES, SCENES_DIR, credit, exr, machine, metrics, report, runner  # noqa: E402
-from tungsten_peer import LoadMeter, channel_means, luminance, scene_film, wait_quiet  # noqa: E402
+from neepp_tools import SCENES_DIR, credit, exr, machine, report, runner  # noqa: E402
+from peer_rounds import channel_means, luminance, run_rounds, summarize_rounds  # noqa: E402
+from tungsten_peer import scene_film  # noqa: E402
 
 #: name: (neepp integrator, pbrt-v4 integrator)
 PAIRS = {"path": ("path", "path"), "bdpt": ("bdpt", "bdpt")}
@@ -433,85 +432,23 @@ def measure(scene: str, pair: str, args, out: Path) -> dict:
     work.mkdir(parents=True, exist_ok=True)
     notes: list[str] = []
 
-    rounds, attempts = [], []
-    for r in range(args.rounds):
-        best = None
-        for attempt in range(args.retries + 1):
-            seed = args.seed + 1000 * r + 100 * attempt
-            order = ["neepp", "pbrt"] if r % 2 == 0 else ["pbrt", "neepp"]
-            runs = {}
-            for who in order:
-                if args.wait_quiet > 0:
-                    wait_quiet(args.max_other_load, args.wait_quiet)
-                with LoadMeter() as lm:
-                    q = render_pair(who, scene, pair, args, work, f"r{r}", res=(w, h), spp=spp,
-                                    max_depth=args.max_depth, seed=seed)
-                notes = q.pop("notes") or notes
-                runs[who] = {**q, **lm.summary()}
-            for k in runs:
-                q = runs[k]
-                q["samples_per_s"] = w * h * spp / q["render_time_s"]
-                # CPU time of the render itself: the process's, less its loading (taken as one busy thread);
-                # samples per CPU second do not depend on how many cores others left free.
-                q["render_cpu_s"] = max(1e-9, q["child_cpu_s"] - max(0.0, q["process_wall_s"] - q["render_time_s"]))
-                q["samples_per_cpu_s"] = w * h * spp / q["render_cpu_s"]
-                if q["render_cpu_s"] < 0.1 * q["render_time_s"]:  # loading estimate failed (a tiny render)
-                    q["samples_per_cpu_s"] = float("nan")
-            worst = max(runs[k]["other_load_cores"] for k in runs)
-            rec = {"round": r, "attempt": attempt, "seed": seed, "order": order,
-                   **{f"{k}_{q}": runs[k][q] for k in runs for q in ("render_time_s", "samples_per_s", "wall_s",
-                                                                     "other_load_cores", "loadavg_1min_before",
-                                                                     "render_cpu_s", "samples_per_cpu_s")}}
-            rec["ratio"] = runs["neepp"]["samples_per_s"] / runs["pbrt"]["samples_per_s"]
-            rec["cpu_ratio"] = runs["neepp"]["samples_per_cpu_s"] / runs["pbrt"]["samples_per_cpu_s"]
-            attempts.append(rec)
-            print(json.dumps({"scene": scene, "pair": pair, **rec}), flush=True)
-            rec["loaded"] = worst > args.max_other_load
-            if best is None or worst < best[0]:  # keep the least disturbed attempt
-                best = (worst, rec, runs["neepp"]["image"], runs["pbrt"]["image"])
-            if worst <= args.max_other_load:
-                break
-        rounds.append(best[1:])
+    def render(who: str, r: int, seed: int) -> dict:
+        nonlocal notes
+        q = render_pair(who, scene, pair, args, work, f"r{r}", res=(w, h), spp=spp, max_depth=args.max_depth,
+                        seed=seed)
+        notes = q.pop("notes") or notes
+        return q
 
-    recs = [x[0] for x in rounds]
-    img_n = np.mean([x[1] for x in rounds], axis=0)
-    img_p = np.mean([x[2] for x in rounds], axis=0)
-    per_round = {k: [channel_means(x[i]) for x in rounds] for k, i in (("neepp", 1), ("pbrt", 2))}
-    ref = exr.read_exr(Path(args.scenes_dir) / scene / "reference" / REFERENCES[scene][3])
-    mean_n, mean_p, mean_r = channel_means(img_n), channel_means(img_p), channel_means(ref)
-
-    def lum_err(k):  # standard error of the luminance mean from the rounds' spread
-        lums = [luminance(m) for m in per_round[k]]
-        return statistics.stdev(lums) / math.sqrt(len(lums)) if len(lums) > 1 else float("nan")
-
-    f = ref.shape[1] // w
-    ref_small = metrics.downsample(ref, f) if f >= 1 and ref.shape[1] == w * f and ref.shape[0] == h * f else None
-    relmse = {k: (statistics.median(metrics.relmse(x[i], ref_small) for x in rounds) if ref_small is not None
-                  else float("nan")) for k, i in (("neepp", 1), ("pbrt", 2))}
-    ratios = metrics.paired_ratios([x["ratio"] for x in recs])
-    t_n = statistics.median(x["neepp_render_time_s"] for x in recs)
-    t_p = statistics.median(x["pbrt_render_time_s"] for x in recs)
+    rounds, attempts = run_rounds(args, scene, pair, "pbrt", w * h, spp, render)
+    summary, img_n, img_p, ref_small = summarize_rounds(args, scene, "pbrt", rounds, w, h)
     row = {"scene": scene, "pair": pair, "res": f"{w}x{h}", "max_depth": args.max_depth,
-           "pbrt maxdepth": args.max_depth - DEPTH_OFFSET, "spp": spp, "rounds": len(recs),
-           "neepp s": t_n, "pbrt s": t_p,
-           "neepp samples/s": statistics.median(x["neepp_samples_per_s"] for x in recs),
-           "pbrt samples/s": statistics.median(x["pbrt_samples_per_s"] for x in recs),
-           "ratio (median)": ratios["median"], "ratio min": min(x["ratio"] for x in recs),
-           "ratio max": max(x["ratio"] for x in recs),
-           "cpu-time ratio (median)": statistics.median(x["cpu_ratio"] for x in recs),
-           "neepp Y": luminance(mean_n), "neepp Y stderr": lum_err("neepp"),
-           "pbrt Y": luminance(mean_p), "pbrt Y stderr": lum_err("pbrt"), "ref Y": luminance(mean_r),
-           "neepp/ref": luminance(mean_n) / luminance(mean_r), "pbrt/ref": luminance(mean_p) / luminance(mean_r),
-           "neepp RGB": mean_n, "pbrt RGB": mean_p, "ref RGB": mean_r,
-           "neepp relMSE": relmse["neepp"], "pbrt relMSE": relmse["pbrt"],
-           "efficiency ratio": (relmse["pbrt"] * t_p) / (relmse["neepp"] * t_n),
-           "max other load (cores)": max(max(x["neepp_other_load_cores"], x["pbrt_other_load_cores"]) for x in recs),
+           "pbrt maxdepth": args.max_depth - DEPTH_OFFSET, "spp": spp, "rounds": len(rounds), **summary,
            "pbrt scene": str(Path(args.pbrt_scenes) / scene / "pbrt" / "scene-v4.pbrt"), "scene edits": notes,
-           "ratios": ratios, "rounds_detail": recs, "attempts": attempts}
+           "attempts": attempts}
     exr.write_exr(work / "neepp_mean.exr", img_n)
     exr.write_exr(work / "pbrt_mean.exr", img_p)
     report.comparison_figure(work / "compare.png", {"neepp": img_n, "pbrt-v4": img_p}, ref=ref_small,
-                             title=f"{scene} {pair}: {w}x{h}, {spp} spp x {len(recs)}, max_depth {args.max_depth}",
+                             title=f"{scene} {pair}: {w}x{h}, {spp} spp x {len(rounds)}, max_depth {args.max_depth}",
                              credit=credit(scene))
     return row
 

@@ -74,10 +74,7 @@ from __future__ import annotations
 import argparse
 import json
 import math
-import os
 import re
-import resource
-import statistics
 import subprocess
 import sys
 import time
@@ -89,65 +86,14 @@ import numpy as np
 REPO = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(REPO / "python"))
 
-from neepp_tools import REFERENCES, SCENES_DIR, credit, exr, machine, metrics, report, runner  # noqa: E402
+from neepp_tools import SCENES_DIR, credit, exr, machine, report, runner  # noqa: E402
+from peer_rounds import channel_means, luminance, run_rounds, summarize_rounds  # noqa: E402
 
 #: name: (neepp integrator, Tungsten integrator type)
 PAIRS = {"bdpt": ("bdpt", "bidirectional_path_tracer"), "pssmlt": ("pssmlt", "kelemen_mlt")}
 #: spp (mutations per pixel for pssmlt) per scene and pair, about 10-30 s a render with 2 threads at scale 4
 DEFAULT_SPP = {("cornell-box", "bdpt"): 64, ("veach-ajar", "bdpt"): 32,
                ("cornell-box", "pssmlt"): 64, ("veach-ajar", "pssmlt"): 24}
-LUMA = np.array([0.2126, 0.7152, 0.0722])
-
-
-# ----------------------------------------------------------------------------------------------
-# machine load around a child process
-
-
-def _cpu_busy_s() -> float:
-    """Machine-wide busy CPU seconds since boot (/proc/stat)."""
-    with open("/proc/stat") as f:
-        v = [int(x) for x in f.readline().split()[1:]]
-    user, nice, system, idle, iowait, irq, softirq, steal = (v + [0] * 8)[:8]
-    return (user + nice + system + irq + softirq + steal) / os.sysconf("SC_CLK_TCK")
-
-
-def _children_cpu_s() -> float:
-    r = resource.getrusage(resource.RUSAGE_CHILDREN)
-    return r.ru_utime + r.ru_stime
-
-
-def wait_quiet(max_cores: float, limit_s: float, window_s: float = 2.0) -> float:
-    """Wait until the machine's busy CPU over window_s is under max_cores (at most limit_s); seconds waited."""
-    t0 = time.perf_counter()
-    while True:
-        b0, w0 = _cpu_busy_s(), time.perf_counter()
-        time.sleep(window_s)
-        busy = (_cpu_busy_s() - b0) / (time.perf_counter() - w0)
-        waited = time.perf_counter() - t0
-        if busy < max_cores or waited >= limit_s:
-            return waited
-        time.sleep(5.0)
-
-
-class LoadMeter:
-    """CPU time used by others than this process's waited-for children during a with-block, in cores."""
-
-    def __enter__(self):
-        self.t0, self.busy0, self.child0 = time.perf_counter(), _cpu_busy_s(), _children_cpu_s()
-        self.loadavg0 = os.getloadavg()[0]
-        return self
-
-    def __exit__(self, *exc):
-        self.wall = time.perf_counter() - self.t0
-        self.child_cpu = _children_cpu_s() - self.child0
-        busy = _cpu_busy_s() - self.busy0
-        self.other_cores = max(0.0, (busy - self.child_cpu) / max(self.wall, 1e-9))
-        self.loadavg1 = os.getloadavg()[0]
-        return False
-
-    def summary(self) -> dict:
-        return {"other_load_cores": self.other_cores, "child_cpu_s": self.child_cpu, "process_wall_s": self.wall,
-                "loadavg_1min_before": self.loadavg0, "loadavg_1min_after": self.loadavg1}
 
 
 # ----------------------------------------------------------------------------------------------
@@ -474,14 +420,6 @@ def run_tungsten(binary: Path, scene_json: Path, out_pfm: Path, *, threads: int,
 # ----------------------------------------------------------------------------------------------
 
 
-def channel_means(img: np.ndarray) -> list[float]:
-    return [float(x) for x in np.asarray(img, dtype=np.float64).reshape(-1, 3).mean(axis=0)]
-
-
-def luminance(means: list[float]) -> float:
-    return float(np.dot(LUMA, means))
-
-
 def scene_film(xml: Path) -> tuple[int, int]:
     d = {e.get("name"): e.get("value") for e in ET.parse(xml).getroot().iter("default")}
     return int(d["resx"]), int(d["resy"])
@@ -511,100 +449,32 @@ def measure(scene: str, pair: str, args, out: Path) -> dict:
     if pair == "pssmlt":
         neepp_opts = {"large_step": args.mlt_large_step, "bootstrap": args.mlt_bootstrap}
 
-    rounds, attempts = [], []
-    for r in range(args.rounds):
-        best = None
-        for attempt in range(args.retries + 1):
-            seed = args.seed + 1000 * r + 100 * attempt
-            order = ["neepp", "tungsten"] if r % 2 == 0 else ["tungsten", "neepp"]
-            runs = {}
-            for who in order:
-                if args.wait_quiet > 0:
-                    wait_quiet(args.max_other_load, args.wait_quiet)
-                if who == "neepp":
-                    with LoadMeter() as lm:
-                        res = runner.run_neepp(xml, work / f"neepp_r{r}.exr", spp=spp, resx=w, resy=h,
-                                               max_depth=args.max_depth, seed=seed, threads=args.threads,
-                                               integrator=neepp_integrator, integrator_args=neepp_opts,
-                                               extra_args=["--rfilter", "box"], timeout=7200)
-                    t = float(res.stats["render_time_s"])
-                    runs["neepp"] = {"image": res.image, "render_time_s": t, "wall_s": res.wall_s,
-                                     "load_s": res.stats.get("load_time_s"), **lm.summary()}
-                else:
-                    pfm = work / f"tungsten_r{r}.pfm"
-                    doc = configure_tungsten(json.loads(json.dumps(base)), res=(w, h), integrator=tungsten_integrator,
-                                             max_depth=args.max_depth, spp=spp, out_pfm=pfm,
-                                             out_png=work / f"tungsten_r{r}.png", mlt_large_step=args.mlt_large_step,
-                                             mlt_bootstrap=args.mlt_bootstrap)
-                    sj = work / "tungsten_scene.json"
-                    sj.write_text(json.dumps(doc, indent=1))
-                    with LoadMeter() as lm:
-                        tr = run_tungsten(Path(args.tungsten), sj, pfm, threads=args.threads, seed=seed)
-                    exr.write_exr(work / f"tungsten_r{r}.exr", tr["image"])
-                    runs["tungsten"] = {"image": tr["image"], "render_time_s": tr["render_time_s"],
-                                        "wall_s": tr["wall_s"], **lm.summary()}
-            for k in runs:
-                q = runs[k]
-                q["samples_per_s"] = w * h * spp / q["render_time_s"]
-                # CPU time of the render itself: the process's, less its loading (taken as one busy thread);
-                # samples per CPU second do not depend on how many cores others left free.
-                q["render_cpu_s"] = max(1e-9, q["child_cpu_s"] - max(0.0, q["process_wall_s"] - q["render_time_s"]))
-                q["samples_per_cpu_s"] = w * h * spp / q["render_cpu_s"]
-            worst = max(runs[k]["other_load_cores"] for k in runs)
-            rec = {"round": r, "attempt": attempt, "seed": seed, "order": order,
-                   **{f"{k}_{q}": runs[k][q] for k in runs for q in ("render_time_s", "samples_per_s", "wall_s",
-                                                                     "other_load_cores", "loadavg_1min_before",
-                                                                     "render_cpu_s", "samples_per_cpu_s")}}
-            rec["ratio"] = runs["neepp"]["samples_per_s"] / runs["tungsten"]["samples_per_s"]
-            rec["cpu_ratio"] = runs["neepp"]["samples_per_cpu_s"] / runs["tungsten"]["samples_per_cpu_s"]
-            attempts.append(rec)
-            print(json.dumps({"scene": scene, "pair": pair, **rec}), flush=True)
-            rec["loaded"] = worst > args.max_other_load
-            if best is None or worst < best[0]:  # keep the least disturbed attempt
-                best = (worst, rec, runs["neepp"]["image"], runs["tungsten"]["image"])
-            if worst <= args.max_other_load:
-                break
-        rounds.append(best[1:])
+    def render(who: str, r: int, seed: int) -> dict:
+        if who == "neepp":
+            res = runner.run_neepp(xml, work / f"neepp_r{r}.exr", spp=spp, resx=w, resy=h, max_depth=args.max_depth,
+                                   seed=seed, threads=args.threads, integrator=neepp_integrator,
+                                   integrator_args=neepp_opts, extra_args=["--rfilter", "box"], timeout=7200)
+            return {"image": res.image, "render_time_s": float(res.stats["render_time_s"]), "wall_s": res.wall_s,
+                    "load_s": res.stats.get("load_time_s")}
+        pfm = work / f"tungsten_r{r}.pfm"
+        doc = configure_tungsten(json.loads(json.dumps(base)), res=(w, h), integrator=tungsten_integrator,
+                                 max_depth=args.max_depth, spp=spp, out_pfm=pfm, out_png=work / f"tungsten_r{r}.png",
+                                 mlt_large_step=args.mlt_large_step, mlt_bootstrap=args.mlt_bootstrap)
+        sj = work / "tungsten_scene.json"
+        sj.write_text(json.dumps(doc, indent=1))
+        tr = run_tungsten(Path(args.tungsten), sj, pfm, threads=args.threads, seed=seed)
+        exr.write_exr(work / f"tungsten_r{r}.exr", tr["image"])
+        return {"image": tr["image"], "render_time_s": tr["render_time_s"], "wall_s": tr["wall_s"]}
 
-    recs = [x[0] for x in rounds]
-    img_n = np.mean([x[1] for x in rounds], axis=0)
-    img_t = np.mean([x[2] for x in rounds], axis=0)
-    per_round = {k: [channel_means(x[i]) for x in rounds] for k, i in (("neepp", 1), ("tungsten", 2))}
-    ref_name = REFERENCES[scene][3]
-    ref = exr.read_exr(Path(args.scenes_dir) / scene / "reference" / ref_name)
-    mean_n, mean_t, mean_r = channel_means(img_n), channel_means(img_t), channel_means(ref)
-
-    def lum_err(k):  # standard error of the luminance mean from the rounds' spread
-        lums = [luminance(m) for m in per_round[k]]
-        return statistics.stdev(lums) / math.sqrt(len(lums)) if len(lums) > 1 else float("nan")
-
-    f = ref.shape[1] // w
-    ref_small = metrics.downsample(ref, f) if f >= 1 and ref.shape[1] == w * f and ref.shape[0] == h * f else None
-    relmse = {k: (statistics.median(metrics.relmse(x[i], ref_small) for x in rounds) if ref_small is not None
-                  else float("nan")) for k, i in (("neepp", 1), ("tungsten", 2))}
-    ratios = metrics.paired_ratios([x["ratio"] for x in recs])
+    rounds, attempts = run_rounds(args, scene, pair, "tungsten", w * h, spp, render)
+    summary, img_n, img_t, ref_small = summarize_rounds(args, scene, "tungsten", rounds, w, h)
     row = {"scene": scene, "pair": pair, "res": f"{w}x{h}", "max_depth": args.max_depth,
-           "tungsten max_bounces": args.max_depth, "spp": spp, "rounds": len(recs),
-           "neepp s": statistics.median(x["neepp_render_time_s"] for x in recs),
-           "tungsten s": statistics.median(x["tungsten_render_time_s"] for x in recs),
-           "neepp samples/s": statistics.median(x["neepp_samples_per_s"] for x in recs),
-           "tungsten samples/s": statistics.median(x["tungsten_samples_per_s"] for x in recs),
-           "ratio (median)": ratios["median"], "ratio min": min(x["ratio"] for x in recs),
-           "ratio max": max(x["ratio"] for x in recs),
-           "cpu-time ratio (median)": statistics.median(x["cpu_ratio"] for x in recs),
-           "neepp Y": luminance(mean_n), "neepp Y stderr": lum_err("neepp"),
-           "tungsten Y": luminance(mean_t), "tungsten Y stderr": lum_err("tungsten"), "ref Y": luminance(mean_r),
-           "neepp/ref": luminance(mean_n) / luminance(mean_r), "tungsten/ref": luminance(mean_t) / luminance(mean_r),
-           "neepp RGB": mean_n, "tungsten RGB": mean_t, "ref RGB": mean_r,
-           "neepp relMSE": relmse["neepp"], "tungsten relMSE": relmse["tungsten"],
-           "efficiency ratio": (relmse["tungsten"] * statistics.median(x["tungsten_render_time_s"] for x in recs)) /
-                               (relmse["neepp"] * statistics.median(x["neepp_render_time_s"] for x in recs)),
-           "max other load (cores)": max(max(x["neepp_other_load_cores"], x["tungsten_other_load_cores"]) for x in recs),
-           "tungsten scene": source, "ratios": ratios, "rounds_detail": recs, "attempts": attempts}
+           "tungsten max_bounces": args.max_depth, "spp": spp, "rounds": len(rounds), **summary,
+           "tungsten scene": source, "attempts": attempts}
     exr.write_exr(work / "neepp_mean.exr", img_n)
     exr.write_exr(work / "tungsten_mean.exr", img_t)
     report.comparison_figure(work / "compare.png", {"neepp": img_n, "tungsten": img_t}, ref=ref_small,
-                             title=f"{scene} {pair}: {w}x{h}, {spp} spp x {len(recs)}, max_depth {args.max_depth}",
+                             title=f"{scene} {pair}: {w}x{h}, {spp} spp x {len(rounds)}, max_depth {args.max_depth}",
                              credit=credit(scene))
     return row
 
